@@ -1,0 +1,102 @@
+// Warp stage benchmarks (issue: mesh warping). Arguments: width, height,
+// channels (1 = mono8, 3 = bgr8), threads.
+//   build/devel/lib/steadiface/steadiface_warp_benchmark
+#include <benchmark/benchmark.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "steadiface_core/so3.h"
+#include "steadiface_core/warper.h"
+
+namespace steadiface {
+namespace {
+
+struct Fixture {
+  CameraModel model;
+  std::unique_ptr<Warper> warper;
+  cv::Mat input, output;
+  RowRotations rows;
+  Eigen::Quaterniond R_v;
+  Eigen::Vector2d t{0.01, -0.005};
+
+  Fixture(int w, int h, int channels, int threads) {
+    CameraModel::Create(IntrinsicsFromHorizontalFov(w, h, 1.2),
+                        CameraModelOptions(), &model);
+    WarpOptions o;
+    o.num_threads = threads;
+    Warper::Create(model, o, &warper);
+    input.create(h, w, channels == 1 ? CV_8UC1 : CV_8UC3);
+    cv::randu(input, cv::Scalar::all(0), cv::Scalar::all(255));
+    // A rolling-shutter frame: 25 mrad of rotation over the readout.
+    const Eigen::Quaterniond top = ExpSO3(Eigen::Vector3d(0.01, 0.02, 0.0));
+    OrientationTimeline tl{OrientationTimelineOptions()};
+    for (int i = 0; i <= 100; ++i) {
+      tl.AddSample({Time(FromSeconds(i * 0.001)), Eigen::Vector3d(0.3, 0.8, 0.1)});
+    }
+    RollingShutterOptions rs;
+    rs.readout_time_s = 0.03;
+    RowRotations::Build(tl, RowTiming(rs, h), Time(FromSeconds(0.02)), 32, &rows);
+    R_v = rows.Middle() * ExpSO3(Eigen::Vector3d(0.005, -0.01, 0.002));
+    (void)top;
+  }
+};
+
+void Args(benchmark::internal::Benchmark* b) {
+  for (int threads : {1, 2}) {
+    for (auto wh : {std::make_pair(640, 480), std::make_pair(1280, 720),
+                    std::make_pair(1920, 1080)}) {
+      for (int ch : {3, 1}) b->Args({wh.first, wh.second, ch, threads});
+    }
+  }
+  b->ArgNames({"w", "h", "ch", "threads"})->Unit(benchmark::kMillisecond);
+}
+
+void BM_Mesh(benchmark::State& state) {
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  for (auto _ : state) {
+    f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  }
+}
+
+void BM_Maps(benchmark::State& state) {
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  for (auto _ : state) f.warper->BuildMaps();
+}
+
+void BM_Remap(benchmark::State& state) {
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  f.warper->BuildMaps();
+  for (auto _ : state) f.warper->Remap(f.input, &f.output);
+}
+
+void BM_WarpEndToEnd(benchmark::State& state) {
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  for (auto _ : state) f.warper->Warp(f.input, f.R_v, f.t, f.rows, &f.output);
+}
+
+// The floor: a bare cv::remap with precomputed float maps.
+void BM_BareRemapFloor(benchmark::State& state) {
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  f.warper->BuildMaps();
+  cv::Mat mx, my, m1, m2;
+  f.warper->FloatMaps(&mx, &my);
+  cv::convertMaps(mx, my, m1, m2, CV_16SC2);
+  for (auto _ : state) {
+    cv::remap(f.input, f.output, m1, m2, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  }
+}
+
+BENCHMARK(BM_Mesh)->Apply(Args);
+BENCHMARK(BM_Maps)->Apply(Args);
+BENCHMARK(BM_Remap)->Apply(Args);
+BENCHMARK(BM_WarpEndToEnd)->Apply(Args);
+BENCHMARK(BM_BareRemapFloor)->Apply(Args);
+
+}  // namespace
+}  // namespace steadiface
+
+BENCHMARK_MAIN();

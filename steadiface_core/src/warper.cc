@@ -1,0 +1,236 @@
+#include "steadiface_core/warper.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "steadiface_core/warp_geometry.h"
+
+namespace steadiface {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(
+             std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+constexpr int kInterBits = 5;  // OpenCV's INTER_BITS
+constexpr int kInterTabSize = 1 << kInterBits;
+
+}  // namespace
+
+Status ValidateWarpOptions(const WarpOptions& o) {
+  Status s = ValidateOutputOptions(o.output);
+  if (!s.ok()) return s;
+  std::ostringstream err;
+  if (o.mesh_cols < 1 || o.mesh_cols > 512 || o.mesh_rows < 1 ||
+      o.mesh_rows > 512) {
+    err << "warp.mesh_cols/mesh_rows must be in [1, 512], got "
+        << o.mesh_cols << "x" << o.mesh_rows;
+  } else if (o.distortion_cell_px < 2 || o.distortion_cell_px > 1024) {
+    err << "warp.distortion_cell_px must be in [2, 1024], got "
+        << o.distortion_cell_px;
+  } else if (o.fixed_point_iterations < 1 || o.fixed_point_iterations > 50) {
+    err << "warp.fixed_point_iterations must be in [1, 50], got "
+        << o.fixed_point_iterations;
+  } else if (o.num_threads < 0 || o.num_threads > 256) {
+    err << "warp.num_threads must be in [0, 256], got " << o.num_threads;
+  } else if (o.protrusion_samples_per_edge < 2 ||
+             o.protrusion_samples_per_edge > 1024) {
+    err << "warp.protrusion_samples_per_edge must be in [2, 1024], got "
+        << o.protrusion_samples_per_edge;
+  }
+  if (err.tellp() != 0) return Status::Error(err.str());
+  return Status::Ok();
+}
+
+Status Warper::Create(const CameraModel& model, const WarpOptions& options,
+                      std::unique_ptr<Warper>* out) {
+  Status s = ValidateWarpOptions(options);
+  if (!s.ok()) return s;
+  OutputGeometry output;
+  s = OutputGeometry::Create(model, options.output, &output);
+  if (!s.ok()) return s;
+  if (options.num_threads > 0) cv::setNumThreads(options.num_threads);
+  out->reset(new Warper(model, options, output));
+  return Status::Ok();
+}
+
+Warper::Warper(const CameraModel& model, const WarpOptions& options,
+               const OutputGeometry& output)
+    : model_(model),
+      options_(options),
+      output_(output),
+      protrusion_(model, output, options.protrusion_samples_per_edge) {
+  int cols = options.mesh_cols, rows = options.mesh_rows;
+  if (model.intrinsics().HasDistortion()) {
+    const int cell = options.distortion_cell_px;
+    cols = std::max(cols, (output.width() + cell - 1) / cell);
+    rows = std::max(rows, (output.height() + cell - 1) / cell);
+  }
+  mesh_.cols = cols + 1;
+  mesh_.rows = rows + 1;
+  mesh_.u.resize(mesh_.cols);
+  mesh_.v.resize(mesh_.rows);
+  for (int i = 0; i < mesh_.cols; ++i) {
+    mesh_.u[i] = static_cast<double>(i) * (output.width() - 1) / cols;
+  }
+  for (int j = 0; j < mesh_.rows; ++j) {
+    mesh_.v[j] = static_cast<double>(j) * (output.height() - 1) / rows;
+  }
+  mesh_.source.resize(mesh_.cols * mesh_.rows);
+  mesh_.source_row.resize(mesh_.cols * mesh_.rows);
+}
+
+Status Warper::ComputeMesh(const Eigen::Quaterniond& R_v,
+                           const Eigen::Vector2d& t,
+                           const RowRotations& rows) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!R_v.coeffs().allFinite() || std::abs(R_v.norm() - 1.0) > 1e-6 ||
+      !t.allFinite()) {
+    return Status::Error("warp: non-finite or non-unit virtual pose refused");
+  }
+  if (rows.empty() || rows.height() != model_.intrinsics().height) {
+    return Status::Error("warp: row rotations missing or for another size");
+  }
+  double row = 0.5 * (rows.height() - 1);
+  for (int j = 0; j < mesh_.rows; ++j) {
+    for (int i = 0; i < mesh_.cols; ++i) {
+      const Eigen::Vector2d V =
+          output_.OutputPixelToVirtual({mesh_.u[i], mesh_.v[j]});
+      Eigen::Vector2d p;
+      // Start from the previous vertex's row: neighbours land on nearby rows.
+      if (!VirtualToRealPixelRS(model_, R_v, t, rows, V,
+                                options_.fixed_point_iterations, 1e-3, &p,
+                                &row)) {
+        return Status::Error(
+            "warp: degenerate pose, part of the output maps behind the "
+            "camera");
+      }
+      const size_t k = static_cast<size_t>(j) * mesh_.cols + i;
+      mesh_.source[k] = p.cast<float>();
+      mesh_.source_row[k] = static_cast<float>(row);
+    }
+    // Next mesh row starts from this row's first vertex.
+    row = mesh_.source_row[static_cast<size_t>(j) * mesh_.cols];
+  }
+  timings_.mesh_ms = MsSince(start);
+  return Status::Ok();
+}
+
+void Warper::BuildMaps() {
+  const auto start = std::chrono::steady_clock::now();
+  const int W = output_.width(), H = output_.height();
+  if (options_.fixed_point_maps) {
+    map1_.create(H, W, CV_16SC2);
+    map2_.create(H, W, CV_16UC1);
+  } else {
+    map1_.create(H, W, CV_32FC1);
+    map2_.create(H, W, CV_32FC1);
+  }
+  const WarpMesh& m = mesh_;
+  const int cells_x = m.cols - 1;
+  const bool fixed = options_.fixed_point_maps;
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
+    std::vector<Eigen::Vector2f> line(m.cols);
+    for (int v = range.start; v < range.end; ++v) {
+      // Cell row and weight.
+      int j = 0;
+      while (j + 1 < m.rows - 1 && m.v[j + 1] < v) ++j;
+      const double span_v = m.v[j + 1] - m.v[j];
+      const float b = span_v > 0 ? static_cast<float>((v - m.v[j]) / span_v)
+                                 : 0.0f;
+      const Eigen::Vector2f* top = &m.source[static_cast<size_t>(j) * m.cols];
+      const Eigen::Vector2f* bot = top + m.cols;
+      for (int i = 0; i < m.cols; ++i) line[i] = (1.0f - b) * top[i] + b * bot[i];
+      short* out1 = fixed ? map1_.ptr<short>(v) : nullptr;
+      ushort* out2 = fixed ? map2_.ptr<ushort>(v) : nullptr;
+      float* fx = fixed ? nullptr : map1_.ptr<float>(v);
+      float* fy = fixed ? nullptr : map2_.ptr<float>(v);
+      for (int i = 0; i < cells_x; ++i) {
+        const int u0 = static_cast<int>(std::ceil(m.u[i]));
+        const int u1 = i + 1 == cells_x
+                           ? W - 1
+                           : static_cast<int>(std::ceil(m.u[i + 1])) - 1;
+        const double span_u = m.u[i + 1] - m.u[i];
+        const float inv_span = static_cast<float>(span_u > 0 ? 1.0 / span_u : 0.0);
+        const float offset = static_cast<float>(u0 - m.u[i]);
+        const float dx = (line[i + 1].x() - line[i].x()) * inv_span;
+        const float dy = (line[i + 1].y() - line[i].y()) * inv_span;
+        const float x0 = line[i].x() + dx * offset;
+        const float y0 = line[i].y() + dy * offset;
+        if (fixed) {
+          // As cv::convertMaps: 1/32 px fixed point, integer part in map1,
+          // interpolation-table index in map2. Far-out coordinates clamp
+          // (they sample the black border either way).
+          const float s = static_cast<float>(kInterTabSize);
+          for (int u = u0; u <= u1; ++u) {
+            const float k = static_cast<float>(u - u0);
+            const float px = std::min(std::max(x0 + dx * k, -16000.0f), 16000.0f);
+            const float py = std::min(std::max(y0 + dy * k, -16000.0f), 16000.0f);
+            const int ix = cvRound(px * s);
+            const int iy = cvRound(py * s);
+            out1[2 * u] = static_cast<short>(ix >> kInterBits);
+            out1[2 * u + 1] = static_cast<short>(iy >> kInterBits);
+            out2[u] = static_cast<ushort>((iy & (kInterTabSize - 1)) * kInterTabSize +
+                                          (ix & (kInterTabSize - 1)));
+          }
+        } else {
+          for (int u = u0; u <= u1; ++u) {
+            const float k = static_cast<float>(u - u0);
+            fx[u] = x0 + dx * k;
+            fy[u] = y0 + dy * k;
+          }
+        }
+      }
+    }
+  });
+  timings_.maps_ms = MsSince(start);
+}
+
+Status Warper::Remap(const cv::Mat& input, cv::Mat* output) {
+  const CameraIntrinsics& k = model_.intrinsics();
+  if (input.empty() || input.cols != k.width || input.rows != k.height) {
+    std::ostringstream err;
+    err << "warp: input is " << input.cols << "x" << input.rows
+        << ", expected " << k.width << "x" << k.height;
+    return Status::Error(err.str());
+  }
+  if (input.depth() != CV_8U || input.channels() < 1 || input.channels() > 4) {
+    return Status::Error("warp: input must be 8-bit with 1-4 channels");
+  }
+  if (map1_.empty()) return Status::Error("warp: no maps built yet");
+  const auto start = std::chrono::steady_clock::now();
+  cv::remap(input, *output, map1_, map2_, cv::INTER_LINEAR,
+            cv::BORDER_CONSTANT, cv::Scalar::all(0));
+  timings_.remap_ms = MsSince(start);
+  return Status::Ok();
+}
+
+Status Warper::Warp(const cv::Mat& input, const Eigen::Quaterniond& R_v,
+                    const Eigen::Vector2d& t, const RowRotations& rows,
+                    cv::Mat* output) {
+  Status s = ComputeMesh(R_v, t, rows);
+  if (!s.ok()) return s;
+  BuildMaps();
+  return Remap(input, output);
+}
+
+void Warper::FloatMaps(cv::Mat* map_x, cv::Mat* map_y) const {
+  if (options_.fixed_point_maps) {
+    cv::Mat xy;
+    cv::convertMaps(map1_, map2_, xy, cv::noArray(), CV_32FC2);
+    std::vector<cv::Mat> ch;
+    cv::split(xy, ch);
+    *map_x = ch[0];
+    *map_y = ch[1];
+  } else {
+    *map_x = map1_.clone();
+    *map_y = map2_.clone();
+  }
+}
+
+}  // namespace steadiface
