@@ -1,0 +1,174 @@
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "steadiface_core/camera_model.h"
+#include "steadiface_core/face_observation.h"
+#include "steadiface_core/orientation_timeline.h"
+#include "steadiface_core/output_geometry.h"
+#include "steadiface_core/protrusion.h"
+#include "steadiface_core/rolling_shutter.h"
+#include "steadiface_core/row_rotations.h"
+#include "steadiface_core/stabilizer/dynamic_weights.h"
+#include "steadiface_core/stabilizer/head_smoother.h"
+#include "steadiface_core/stabilizer/stabilizer_options.h"
+#include "steadiface_core/status.h"
+#include "steadiface_core/time.h"
+
+namespace steadiface {
+
+/// Energy of each term at the returned pose, weights included
+/// (w_term * E_term), and their sum.
+struct TermEnergies {
+  double fit = 0.0;
+  double distortion = 0.0;
+  double follow = 0.0;
+  double rotation = 0.0;
+  double translation = 0.0;
+  double protrusion = 0.0;
+  double total() const {
+    return fit + distortion + follow + rotation + translation + protrusion;
+  }
+};
+
+/// What Ceres reported for this frame's solve.
+struct SolverReport {
+  bool ran = false;
+  bool usable = false;
+  int iterations = 0;
+  std::string termination;  ///< CONVERGENCE, NO_CONVERGENCE, FAILURE, ...
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  double time_ms = 0.0;
+};
+
+/// Why the pose is what it is.
+struct StabilizerFlags {
+  bool face_used = false;          ///< a face entered E_f this frame
+  /// The face was lost: E_f fits the last landmarks, held fixed in the world
+  /// (moved by the gyro), while w_f fades out, so the pose does not jump.
+  bool held_face = false;
+  bool solver_failed = false;      ///< solve unusable; kept previous warp
+  bool protrusion_search = false;  ///< binary search toward P_r ran
+  double protrusion_search_s = 0.0;  ///< fraction moved towards P_r [0-1]
+  bool previous_warp = false;      ///< nothing valid; previous warp reused
+  bool undefined_pixels = false;   ///< output still has undefined pixels
+  bool first_frame = false;
+};
+
+struct StabilizerTimings {
+  double weights_ms = 0.0;
+  double smoothing_ms = 0.0;
+  double solve_ms = 0.0;
+  double protrusion_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+/// Everything about one stabilized frame.
+struct StabilizerFrame {
+  Time stamp;
+  /// Virtual rotation R_v (world -> virtual camera) and principal offset t.
+  Eigen::Quaterniond R_v = Eigen::Quaterniond::Identity();
+  Eigen::Vector2d t = Eigen::Vector2d::Zero();
+  /// Real rotation at the middle row, and per row.
+  Eigen::Quaterniond R_r = Eigen::Quaterniond::Identity();
+  RowRotations rows;
+  /// Target head centre H and landmark centre C (valid when has_target).
+  bool has_target = false;
+  Eigen::Vector2d H = Eigen::Vector2d::Zero();
+  Eigen::Vector2d C = Eigen::Vector2d::Zero();
+  /// Weights in effect (base weights times the dynamic factors).
+  StabilizerWeights weights;
+  WeightFactors factors;
+  TermEnergies energies;
+  SolverReport solver;
+  StabilizerFlags flags;
+  StabilizerTimings timings;
+};
+
+/// Running counters since start (reset() keeps them).
+struct StabilizerStats {
+  uint64_t frames = 0;
+  uint64_t frames_with_face = 0;
+  uint64_t solver_failures = 0;
+  uint64_t protrusion_searches = 0;
+  uint64_t previous_warp_fallbacks = 0;
+  uint64_t undefined_frames = 0;
+  uint64_t no_gyro_frames = 0;
+  uint64_t resets = 0;
+};
+
+/// The face-centric stabilizer (paper §3.2 and §4): per frame and causally,
+/// smooth the head target (Eq. 1), adjust weights (§4.4), solve for the
+/// virtual pose {R_v, t} minimizing
+///   w_f E_f + w_d E_d + w_o E_o + w_r E_r + w_t E_t + w_p E_p    (Eq. 5)
+/// with Ceres, then remove any protrusion by binary search between the
+/// solution and the real pose, falling back to the previous warp when
+/// nothing valid exists.
+///
+/// Deterministic (single-threaded Ceres, no wall-clock dependence unless
+/// solver.max_time_s is hit). Not thread-safe: one instance per stream.
+class Stabilizer {
+ public:
+  static Status Create(const CameraModel& model, const OutputOptions& output,
+                       const StabilizerOptions& options,
+                       std::unique_ptr<Stabilizer>* out);
+
+  /// Processes the frame stamped `stamp` (camera clock). `face` may be null
+  /// or invalid (then gyro-only with w_f fading out). Fails, leaving the
+  /// state untouched, when the timeline does not cover the frame's rows.
+  Status Process(Time stamp, const OrientationTimeline& timeline,
+                 const RowTiming& timing, const FaceObservation* face,
+                 StabilizerFrame* frame);
+
+  /// Replaces the tunable options (weights, terms, dynamic, solver, head,
+  /// gyro_only) from the next frame on. Validated; on error nothing changes.
+  Status UpdateOptions(const StabilizerOptions& options);
+
+  /// Forgets the trajectory (time jumped, new epoch). Counters are kept.
+  void reset();
+
+  const StabilizerOptions& options() const { return options_; }
+  const StabilizerStats& stats() const { return stats_; }
+  const OutputGeometry& output_geometry() const { return output_; }
+  const ProtrusionGeometry& protrusion() const { return protrusion_; }
+
+ private:
+  Stabilizer(const CameraModel& model, const OutputGeometry& output,
+             const StabilizerOptions& options);
+
+  // One Ceres solve from the initial pose; fills the report and energies.
+  bool Solve(const RowRotations& rows, const FaceObservation* face,
+             const Eigen::Vector2d& H, const StabilizerWeights& w,
+             Eigen::Quaterniond* R_v, Eigen::Vector2d* t,
+             SolverReport* report, TermEnergies* energies) const;
+
+  const CameraModel model_;
+  const OutputGeometry output_;
+  const ProtrusionGeometry protrusion_;
+  StabilizerOptions options_;
+  HeadSmoother smoother_;
+  DynamicWeights dynamic_;
+  StabilizerStats stats_;
+
+  // Trajectory state.
+  int history_ = 0;  // frames since start/reset (capped at 2)
+  Time last_stamp_;
+  Eigen::Quaterniond R_v_prev_ = Eigen::Quaterniond::Identity();
+  Eigen::Quaterniond R_v_prev_prev_ = Eigen::Quaterniond::Identity();
+  Eigen::Quaterniond R_r_prev_ = Eigen::Quaterniond::Identity();
+  Eigen::Vector2d t_prev_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d t_prev_prev_ = Eigen::Vector2d::Zero();
+  bool has_H_ = false;
+  Eigen::Vector2d H_prev_ = Eigen::Vector2d::Zero();
+  // Last usable face, as seen by a world-fixed camera (R = identity), for
+  // the fade-out after a loss.
+  bool has_held_face_ = false;
+  FaceObservation held_face_;
+};
+
+}  // namespace steadiface

@@ -1,0 +1,126 @@
+#pragma once
+
+#include "steadiface_core/stabilizer/head_smoother.h"
+#include "steadiface_core/status.h"
+
+namespace steadiface {
+
+/// Base weights of the objective (paper Eq. 5). Dynamic adjustment scales
+/// them per frame; the weights in effect are reported with every frame.
+struct StabilizerWeights {
+  /// w_f: landmark fitting E_f [-].
+  double fit = 100.0;
+  /// w_d: distortion E_d [-].
+  double distortion = 200.0;
+  /// w_o: rotation following E_o [-].
+  double follow = 0.5;
+  /// w_r,C0: rotation smoothness, C0 part of E_r [-].
+  double rotation_c0 = 10.0;
+  /// w_r,C1: rotation smoothness, C1 part of E_r [-].
+  double rotation_c1 = 40.0;
+  /// w_t,C0: principal offset smoothness, C0 part of E_t [-].
+  double translation_c0 = 20.0;
+  /// w_t,C1: principal offset smoothness, C1 part of E_t [-].
+  double translation_c1 = 80.0;
+  /// w_p: protrusion E_p [-].
+  double protrusion = 1.0;
+};
+
+/// Shapes of individual terms.
+struct TermOptions {
+  /// E_d: angle between virtual and real camera below which the logistic
+  /// makes the penalty ~0 [rad].
+  double distortion_threshold_rad = 0.08;
+  /// E_d: logistic slope [1/rad].
+  double distortion_slope = 150.0;
+  /// E_p: α, the tolerated protrusion [normalized units, fraction of width].
+  double protrusion_alpha = 0.002;
+  /// E_p: the real boundary is shrunk by this on every side before measuring
+  /// protrusion [fraction of width].
+  double protrusion_shrink = 0.005;
+  /// E_p: boundary samples per output edge [count].
+  int protrusion_samples_per_edge = 8;
+};
+
+/// Dynamic weight adjustment (paper §4.4). Every factor moves towards its
+/// target with the time constant `fade_time_s`, so weights never jump.
+struct DynamicWeightOptions {
+  /// Master switch; off = base weights (and no face = w_f 0) only.
+  bool enabled = true;
+  /// Time constant of every weight change, including the fade in/out of w_f
+  /// when the face appears or is lost [s].
+  double fade_time_s = 0.25;
+  /// Window of the mean |omega| [s].
+  double gyro_window_s = 0.5;
+  /// Mean |omega| at or below which the camera counts as still [rad/s].
+  double gyro_still_rad_s = 0.015;
+  /// Mean |omega| at or above which w_f is at full strength [rad/s].
+  double gyro_active_rad_s = 0.06;
+  /// w_f scale for a still camera [-] (0 = the virtual camera ignores the
+  /// face when the camera is still).
+  double gyro_still_fit_scale = 0.0;
+  /// |yaw| or |pitch| at which w_f starts to drop [rad].
+  double pose_low_rad = 0.35;
+  /// |yaw| or |pitch| at which w_f reaches pose_min_fit_scale [rad].
+  double pose_high_rad = 0.7;
+  /// w_f scale at large head pose [-].
+  double pose_min_fit_scale = 0.1;
+  /// Smoothness weights are multiplied by (1 + boost) at large head pose [-].
+  double pose_smoothness_boost = 3.0;
+  /// Frames in the landmark-variation window [count].
+  int variation_window = 10;
+  /// RMS second difference of the gyro-compensated landmark centre at which
+  /// w_f starts to drop [normalized units].
+  double centre_variation_low = 0.004;
+  /// ... and reaches variation_min_fit_scale [normalized units].
+  double centre_variation_high = 0.015;
+  /// RMS relative second difference of the face scale at which w_f starts to
+  /// drop [-].
+  double scale_variation_low = 0.03;
+  /// ... and reaches variation_min_fit_scale [-].
+  double scale_variation_high = 0.1;
+  /// w_f scale for very noisy landmarks [-].
+  double variation_min_fit_scale = 0.15;
+};
+
+/// Ceres settings of the per-frame solve.
+struct SolverOptions {
+  /// Iteration cap per frame [count].
+  int max_iterations = 10;
+  /// Relative cost change that ends the solve [-].
+  double function_tolerance = 1e-6;
+  /// Gradient tolerance [-].
+  double gradient_tolerance = 1e-10;
+  /// Wall-time cap per solve [s].
+  double max_time_s = 0.02;
+};
+
+/// Everything the stabilizer does per frame.
+struct StabilizerOptions {
+  HeadSmootherOptions head;
+  StabilizerWeights weights;
+  TermOptions terms;
+  DynamicWeightOptions dynamic;
+  SolverOptions solver;
+  /// Binary-search steps between the solved and the real pose when the
+  /// solution leaves undefined pixels (paper §4.4) [count].
+  int protrusion_search_steps = 10;
+  /// Rows at which R_r(y) is tabulated per frame [count].
+  int row_rotation_samples = 32;
+  /// Landmarks below this confidence are ignored (as "no face") [0-1].
+  double min_face_confidence = 0.3;
+  /// Gyro-only baseline: ignore faces entirely (w_f = 0).
+  bool gyro_only = false;
+  /// Where Eq. 1 reads the landmark centre C. true (ours): C is first mapped
+  /// into the virtual view predicted from the virtual camera's own smooth
+  /// motion (constant velocity from the last two frames); the real camera's
+  /// rotation shake is then already removed from C, so H only has to filter
+  /// the head's and the hand's translation. false: C in the real frame, as
+  /// the paper writes it, so H also sees (and partly passes) the shake.
+  bool smooth_head_in_virtual_view = true;
+};
+
+Status ValidateStabilizerWeights(const StabilizerWeights& weights);
+Status ValidateStabilizerOptions(const StabilizerOptions& options);
+
+}  // namespace steadiface
