@@ -1,0 +1,143 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/camera_model.h"
+#include "steadiface_core/face/face_detector.h"
+#include "steadiface_core/face/face_types.h"
+#include "steadiface_core/face/landmark_predictor.h"
+#include "steadiface_core/orientation_timeline.h"
+#include "steadiface_core/rolling_shutter.h"
+#include "steadiface_core/status.h"
+#include "steadiface_core/time.h"
+
+namespace steadiface {
+
+struct FaceTrackerOptions {
+  FaceDetectorOptions detector;
+  /// dlib 68-point shape predictor model file.
+  std::string landmark_model_path = kDefaultShapePredictorPath;
+  /// While tracking, re-detect every this many frames (near the face only)
+  /// to re-anchor the box [frames]. After any failure, detection runs on
+  /// the next frame regardless.
+  int redetect_every_frames = 15;
+  /// The re-detection region is the predicted box enlarged by this [-].
+  double redetect_region_scale = 2.2;
+  /// Re-detection near the face runs on a copy scaled so the face is about
+  /// this wide (dlib's HOG finds faces from ~80 px) [px].
+  int redetect_face_px = 100;
+  /// Keep the lock on a lost face this long before re-acquiring the
+  /// largest face anywhere [s].
+  double lost_timeout_s = 1.0;
+  /// Shape plausibility: max RMS residual after similarity alignment to the
+  /// locked face's shape, relative to the face scale [-].
+  double max_shape_residual = 0.2;
+  /// Landmark extent over box size must lie in [min, max] [-].
+  double min_spread_ratio = 0.55;
+  double max_spread_ratio = 1.6;
+  /// Max jump of the landmark centre from its gyro-compensated prediction,
+  /// relative to the face scale [-].
+  double max_jump = 1.2;
+  /// Min normalized cross-correlation of the aligned face patch with the
+  /// locked face's [-].
+  double min_appearance = 0.45;
+  /// Side of the aligned face patch for the appearance check [px].
+  int appearance_patch_px = 40;
+  /// How fast the reference patch follows the face while tracking [0-1].
+  double appearance_update_rate = 0.05;
+  /// Estimate yaw/pitch/roll with solvePnP.
+  bool estimate_head_pose = true;
+};
+
+Status ValidateFaceTrackerOptions(const FaceTrackerOptions& options);
+
+/// Face information extraction (paper §3.1): detect, lock the face of
+/// interest (largest at first sight, kept until lost for lost_timeout_s),
+/// and fit 68 landmarks every frame by tracking: the box is predicted from
+/// the previous landmarks moved by the gyro's rotation between the frames,
+/// and detection re-runs only every N frames or after a failure. Every
+/// frame's landmarks must pass explicit checks (shape, spread, jump,
+/// appearance) to count. Not thread-safe; one instance per stream.
+class FaceTracker {
+ public:
+  /// Loads the landmark model and builds the detector; errors name the
+  /// missing file and the package that ships it.
+  static Status Create(const CameraModel& model,
+                       const FaceTrackerOptions& options,
+                       std::unique_ptr<FaceTracker>* out);
+
+  /// One frame. `image` is 8-bit with 1, 3 (BGR) or 4 (BGRA) channels at the
+  /// camera model's size. `timeline` and `timing` (both optional) enable the
+  /// gyro-compensated prediction. Bad input returns an error and a FaceInfo
+  /// with failure kBadInput; tracking state is kept.
+  Status Process(const cv::Mat& image, Time stamp,
+                 const OrientationTimeline* timeline, const RowTiming* timing,
+                 FaceInfo* info);
+
+  /// Landmarks produced elsewhere (68 points, raw pixels). Runs the same
+  /// checks except appearance (no image), and the same face-of-interest
+  /// state machine; an empty vector means "no face this frame".
+  Status ProcessExternal(const std::vector<Eigen::Vector2d>& landmarks_px,
+                         double external_confidence, Time stamp,
+                         const OrientationTimeline* timeline,
+                         const RowTiming* timing, FaceInfo* info);
+
+  /// Drops the lock (time jumped, new epoch).
+  void reset();
+
+  TrackingState state() const { return state_; }
+  const FaceTrackerOptions& options() const { return options_; }
+
+ private:
+  FaceTracker(const CameraModel& model, const FaceTrackerOptions& options);
+
+  // Shared by both paths once landmarks exist for this frame.
+  struct Candidate {
+    std::vector<Eigen::Vector2d> landmarks;
+    cv::Rect2d box;
+    bool detected = false;
+  };
+  bool Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiring,
+                const Eigen::Vector2d* predicted_centre, FaceInfo* info,
+                cv::Mat* patch) const;
+  void Accept(const cv::Mat* gray, const Candidate& c, bool acquiring,
+              const cv::Mat& patch, Time stamp, FaceInfo* info);
+  void Fill(const std::vector<Eigen::Vector2d>& landmarks, FaceInfo* info) const;
+  bool PredictLandmarks(Time stamp, const OrientationTimeline* timeline,
+                        const RowTiming* timing,
+                        std::vector<Eigen::Vector2d>* predicted) const;
+  cv::Rect2d BoxFromLandmarks(const std::vector<Eigen::Vector2d>& lm) const;
+  bool AlignedPatch(const cv::Mat& gray, const std::vector<Eigen::Vector2d>& lm,
+                    cv::Mat* patch) const;
+  bool DetectAndFit(const cv::Mat& gray, const cv::Rect& roi,
+                    const cv::Rect2d* near, Candidate* c, double* detect_ms);
+  void MarkFailure(FaceFailure f, Time stamp, FaceInfo* info);
+  Eigen::Quaterniond MidRotation(Time stamp, const OrientationTimeline* tl,
+                                 const RowTiming* timing, bool* ok) const;
+
+  const CameraModel model_;
+  const FaceTrackerOptions options_;
+  std::unique_ptr<FaceDetector> detector_;
+  std::unique_ptr<LandmarkPredictor> predictor_;
+  std::vector<Eigen::Vector3d> head_model_;
+
+  TrackingState state_ = TrackingState::kSearching;
+  std::vector<Eigen::Vector2d> last_landmarks_;
+  std::vector<Eigen::Vector2d> reference_shape_;  // similarity-normalized
+  cv::Mat reference_patch_;                      // CV_32F
+  // Box relative to the landmark extent: (dx, dy, sx, sy).
+  Eigen::Vector4d box_model_ = Eigen::Vector4d(0.0, -0.1, 1.05, 1.05);
+  Time last_seen_;
+  bool have_last_rotation_ = false;
+  Eigen::Quaterniond last_rotation_ = Eigen::Quaterniond::Identity();
+  int frames_since_detect_ = 0;
+  int frames_tracked_ = 0;
+  bool force_detect_ = true;
+};
+
+}  // namespace steadiface

@@ -1,0 +1,152 @@
+#include "steadiface_core/face/face_detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <dlib/image_processing/frontal_face_detector.h>
+#include <dlib/opencv/cv_image.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/objdetect.hpp>
+
+namespace steadiface {
+namespace {
+
+// Downscales `roi` of `gray` so its longest side is <= max_side; returns
+// the scale factor applied (<= 1).
+double Downscale(const cv::Mat& gray, const cv::Rect& roi, int max_side,
+                 cv::Mat* out) {
+  const int longest = std::max(roi.width, roi.height);
+  const double s = longest > max_side ? static_cast<double>(max_side) / longest
+                                      : 1.0;
+  if (s < 1.0) {
+    cv::resize(gray(roi), *out, cv::Size(), s, s, cv::INTER_AREA);
+  } else {
+    *out = gray(roi);
+  }
+  return s;
+}
+
+void SortLargestFirst(std::vector<FaceBox>* faces) {
+  std::stable_sort(faces->begin(), faces->end(),
+                   [](const FaceBox& a, const FaceBox& b) {
+                     return a.rect.area() > b.rect.area();
+                   });
+}
+
+Status CheckInput(const cv::Mat& gray, const cv::Rect& roi) {
+  if (gray.empty() || gray.type() != CV_8UC1) {
+    return Status::Error("face detector: need a non-empty 8-bit gray image");
+  }
+  if ((roi & cv::Rect(0, 0, gray.cols, gray.rows)) != roi || roi.area() <= 0) {
+    return Status::Error("face detector: region outside the image");
+  }
+  return Status::Ok();
+}
+
+class DlibHogDetector : public FaceDetector {
+ public:
+  explicit DlibHogDetector(const FaceDetectorOptions& o)
+      : options_(o), detector_(dlib::get_frontal_face_detector()) {}
+
+  Status Detect(const cv::Mat& gray, const cv::Rect& roi,
+                std::vector<FaceBox>* faces, int max_side_px) override {
+    faces->clear();
+    Status st = CheckInput(gray, roi);
+    if (!st.ok()) return st;
+    cv::Mat small;
+    const double s = Downscale(
+        gray, roi, max_side_px > 0 ? max_side_px : options_.max_side_px, &small);
+    if (small.cols < 40 || small.rows < 40) return Status::Ok();
+    if (!small.isContinuous()) small = small.clone();
+    dlib::cv_image<unsigned char> img(small);
+    std::vector<dlib::rect_detection> dets;
+    detector_(img, dets, options_.dlib_threshold);
+    for (const auto& d : dets) {
+      const dlib::rectangle& r = d.rect;
+      FaceBox f;
+      f.rect = cv::Rect2d(roi.x + r.left() / s, roi.y + r.top() / s,
+                          r.width() / s, r.height() / s);
+      f.score = d.detection_confidence;
+      if (f.rect.width >= options_.min_face_px) faces->push_back(f);
+    }
+    SortLargestFirst(faces);
+    return Status::Ok();
+  }
+
+ private:
+  const FaceDetectorOptions options_;
+  dlib::frontal_face_detector detector_;
+};
+
+class CascadeDetector : public FaceDetector {
+ public:
+  CascadeDetector(const FaceDetectorOptions& o) : options_(o) {}
+  bool Load() { return cascade_.load(options_.cascade_path); }
+
+  Status Detect(const cv::Mat& gray, const cv::Rect& roi,
+                std::vector<FaceBox>* faces, int max_side_px) override {
+    faces->clear();
+    Status st = CheckInput(gray, roi);
+    if (!st.ok()) return st;
+    cv::Mat small;
+    const double s = Downscale(
+        gray, roi, max_side_px > 0 ? max_side_px : options_.max_side_px, &small);
+    std::vector<cv::Rect> rects;
+    std::vector<int> neighbours;
+    const int min_px = std::max(20, static_cast<int>(options_.min_face_px * s));
+    cascade_.detectMultiScale(small, rects, neighbours, 1.1, 4, 0,
+                              cv::Size(min_px, min_px));
+    for (size_t i = 0; i < rects.size(); ++i) {
+      FaceBox f;
+      f.rect = cv::Rect2d(roi.x + rects[i].x / s, roi.y + rects[i].y / s,
+                          rects[i].width / s, rects[i].height / s);
+      f.score = i < neighbours.size() ? neighbours[i] : 0;
+      faces->push_back(f);
+    }
+    SortLargestFirst(faces);
+    return Status::Ok();
+  }
+
+ private:
+  const FaceDetectorOptions options_;
+  cv::CascadeClassifier cascade_;
+};
+
+}  // namespace
+
+Status ValidateFaceDetectorOptions(const FaceDetectorOptions& o) {
+  std::ostringstream err;
+  if (o.max_side_px < 64 || o.max_side_px > 8192) {
+    err << "face.detector_max_side must be in [64, 8192] px, got "
+        << o.max_side_px;
+  } else if (!std::isfinite(o.dlib_threshold) || o.dlib_threshold < -2.0 ||
+             o.dlib_threshold > 5.0) {
+    err << "face.dlib_threshold must be in [-2, 5], got " << o.dlib_threshold;
+  } else if (o.min_face_px < 8 || o.min_face_px > 4096) {
+    err << "face.min_face_px must be in [8, 4096], got " << o.min_face_px;
+  }
+  if (err.tellp() != 0) return Status::Error(err.str());
+  return Status::Ok();
+}
+
+Status FaceDetector::Create(const FaceDetectorOptions& options,
+                            std::unique_ptr<FaceDetector>* out) {
+  Status s = ValidateFaceDetectorOptions(options);
+  if (!s.ok()) return s;
+  if (options.type == FaceDetectorType::kDlibHog) {
+    out->reset(new DlibHogDetector(options));
+    return Status::Ok();
+  }
+  std::unique_ptr<CascadeDetector> c(new CascadeDetector(options));
+  if (!c->Load()) {
+    return Status::Error("face cascade '" + options.cascade_path +
+                         "' cannot be loaded (Debian package opencv-data ships "
+                         "the default cascades)");
+  }
+  *out = std::move(c);
+  return Status::Ok();
+}
+
+}  // namespace steadiface
