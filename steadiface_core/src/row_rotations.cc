@@ -28,6 +28,18 @@ QueryResult RowRotations::Build(const OrientationTimeline& timeline,
   return QueryResult::kOk;
 }
 
+RowRotations RowRotations::FromTable(std::vector<Eigen::Quaterniond> table,
+                                     int height) {
+  RowRotations r;
+  r.height_ = std::max(1, height);
+  for (size_t i = 0; i < table.size(); ++i) {
+    table[i].normalize();
+    if (i > 0) table[i] = AlignSign(table[i], table[i - 1]);
+  }
+  r.table_ = std::move(table);
+  return r;
+}
+
 Eigen::Quaterniond RowRotations::At(double y) const {
   if (table_.size() == 1) return table_[0];
   const double n1 = static_cast<double>(table_.size() - 1);

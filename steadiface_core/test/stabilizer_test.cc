@@ -166,14 +166,14 @@ TEST(CostTermsTest, RotationSmoothnessZeroForConstantVelocity) {
   const Eigen::Quaterniond p = step * pp;
   const Eigen::Quaterniond cur = step * p;  // constant angular velocity
   std::unique_ptr<ceres::CostFunction> c(RotationSmoothnessCost::Create(
-      p, p * pp.conjugate(), true, 0.0, 1.0));
+      p, p, p * pp.conjugate(), true, 0.0, 1.0));
   double q[4] = {cur.x(), cur.y(), cur.z(), cur.w()}, r[8];
   const double* params[1] = {q};
   ASSERT_TRUE(c->Evaluate(params, r, nullptr));
   EXPECT_NEAR(Vec8Norm(r), 0.0, 1e-14);
   // C0 at the previous rotation is zero.
   std::unique_ptr<ceres::CostFunction> c0(RotationSmoothnessCost::Create(
-      p, p * pp.conjugate(), false, 1.0, 1.0));
+      p, p, p * pp.conjugate(), false, 1.0, 1.0));
   double qp[4] = {p.x(), p.y(), p.z(), p.w()};
   params[0] = qp;
   ASSERT_TRUE(c0->Evaluate(params, r, nullptr));
@@ -181,7 +181,7 @@ TEST(CostTermsTest, RotationSmoothnessZeroForConstantVelocity) {
   ceres::EigenQuaternionManifold qm;
   const Eigen::Quaterniond off = ExpSO3(Eigen::Vector3d(0.02, -0.01, 0.03)) * cur;
   double qo[4] = {off.x(), off.y(), off.z(), off.w()};
-  CheckGradient(RotationSmoothnessCost::Create(p, p * pp.conjugate(), true, 2.0, 3.0),
+  CheckGradient(RotationSmoothnessCost::Create(step * p, p, p * pp.conjugate(), true, 2.0, 3.0),
                 {&qm}, {qo});
 }
 
@@ -595,8 +595,8 @@ TEST(StabilizerAblationTest, FollowingAndDistortionTermsHoldThePoseDuringAPan) {
   // as post-solve protrusion searches (the paper's fallback).
   const CameraModel m = Model();
   sim::LandmarkSequenceOptions o = Walk();
-  o.camera.pan_rate = 0.25;  // rad/s
-  o.duration_s = 4.0;
+  o.camera.pan_rate = 0.25;  // rad/s, ramped in over 2 s
+  o.duration_s = 6.0;
   const sim::LandmarkSequence seq(m, o);
   StabilizerOptions so;
   so.gyro_only = true;  // isolate the rotation terms

@@ -27,6 +27,10 @@ class RowRotations {
                            const RowTiming& timing, Time stamp, int samples,
                            RowRotations* out);
 
+  /// From rotations at `table.size()` evenly spaced rows 0 .. height-1.
+  static RowRotations FromTable(std::vector<Eigen::Quaterniond> table,
+                                int height);
+
   /// R_r at (fractional) pixel row y, clamped to [0, H-1].
   Eigen::Quaterniond At(double y) const;
   /// R_r at the middle row.

@@ -50,9 +50,19 @@ CameraMotion::CameraMotion(const CameraMotionOptions& o)
       shake_(o.seed, o.shake_lo_hz, o.shake_hi_hz, o.shake_rms_rad),
       translation_(o.seed + 1000, 0.3, 3.0, o.translation_rms_m, 12) {}
 
+double CameraMotion::PanAngle(double t) const {
+  // The pan rate ramps in smoothly (smoothstep) over [pan_start_s,
+  // pan_start_s + pan_ramp_s]; the angle is its exact integral.
+  const double t0 = options_.pan_start_s, T = std::max(1e-9, options_.pan_ramp_s);
+  if (t <= t0) return 0.0;
+  const double u = std::min(1.0, (t - t0) / T);
+  double a = T * (u * u * u - 0.5 * u * u * u * u);
+  if (t > t0 + T) a += t - (t0 + T);
+  return options_.pan_rate * a;
+}
+
 Eigen::Quaterniond CameraMotion::Orientation(double t) const {
-  return ExpSO3(Eigen::Vector3d(0.0, options_.pan_rate * t, 0.0)) *
-         ExpSO3(shake_.Value(t));
+  return ExpSO3(Eigen::Vector3d(0.0, PanAngle(t), 0.0)) * ExpSO3(shake_.Value(t));
 }
 
 Eigen::Vector3d CameraMotion::Position(double t) const {

@@ -271,8 +271,20 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   if (history_ >= 1) {
     const Eigen::Quaterniond prev_delta =
         (R_v_prev_ * R_v_prev_prev_.conjugate()).normalized();
+    Eigen::Quaterniond c0_target = R_v_prev_;
+    if (options_.intentional_window_s > 0.0) {
+      // The real camera's mean rotation per frame over the window.
+      const double W = options_.intentional_window_s;
+      Eigen::Quaterniond R_old;
+      if (QuerySucceeded(timeline.RealRotation(
+              timing.RowTime(stamp, 0.5 * (timing.height() - 1)) - FromSeconds(W),
+              &R_old))) {
+        const Eigen::Vector3d rate = LogSO3(f.R_r * R_old.conjugate()) / W;
+        c0_target = (ExpSO3(rate * dt) * R_v_prev_).normalized();
+      }
+    }
     b_rot.push_back(problem.AddResidualBlock(
-        RotationSmoothnessCost::Create(R_v_prev_, prev_delta, history_ >= 2,
+        RotationSmoothnessCost::Create(c0_target, R_v_prev_, prev_delta, history_ >= 2,
                                        std::sqrt(w.rotation_c0),
                                        std::sqrt(w.rotation_c1)),
         nullptr, q_block));

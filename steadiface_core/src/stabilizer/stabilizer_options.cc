@@ -73,6 +73,7 @@ Status ValidateStabilizerOptions(const StabilizerOptions& o) {
       Range("protrusion_search_steps", o.protrusion_search_steps, 1, 60),
       Range("row_rotation_samples", o.row_rotation_samples, 1, 4096),
       Range("min_face_confidence", o.min_face_confidence, 0, 1),
+      Range("intentional_window", o.intentional_window_s, 0, 5),
   });
   return s;
 }

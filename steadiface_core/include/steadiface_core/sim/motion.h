@@ -32,8 +32,11 @@ class BandLimitedNoise {
 /// over time, rad/s) times hand shake (band-limited rotation vector), plus a
 /// small hand translation. q_wc(t) = Exp(pan t e_y) Exp(shake(t)).
 struct CameraMotionOptions {
-  /// Pan rate about the vertical axis [rad/s].
+  /// Pan rate about the vertical axis [rad/s], reached smoothly over
+  /// [pan_start_s, pan_start_s + pan_ramp_s] [s] (a person starting a pan).
   double pan_rate = 0.0;
+  double pan_start_s = 0.3;
+  double pan_ramp_s = 2.0;
   /// Hand-shake RMS angle per axis [rad].
   double shake_rms_rad = 0.006;
   /// Hand-shake band [Hz].
@@ -50,6 +53,8 @@ class CameraMotion {
   Eigen::Quaterniond Orientation(double t) const;
   /// Camera position in the world [m].
   Eigen::Vector3d Position(double t) const;
+  /// Intentional pan angle at t [rad].
+  double PanAngle(double t) const;
   /// Body-frame angular velocity [rad/s] (exact derivative by a tiny
   /// central difference of the analytic orientation).
   Eigen::Vector3d AngularVelocity(double t) const;

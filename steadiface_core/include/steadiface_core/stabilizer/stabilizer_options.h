@@ -118,6 +118,11 @@ struct StabilizerOptions {
   /// the head's and the hand's translation. false: C in the real frame, as
   /// the paper writes it, so H also sees (and partly passes) the shake.
   bool smooth_head_in_virtual_view = true;
+  /// E_r's C0 term pulls towards the previous virtual rotation moved by the
+  /// camera's intentional rotation: its mean rate over this trailing window
+  /// [s] (ours; removes the lag of the paper's C0 term during pans). 0 =
+  /// the paper's term (towards the previous virtual rotation).
+  double intentional_window_s = 0.0;
 };
 
 Status ValidateStabilizerWeights(const StabilizerWeights& weights);

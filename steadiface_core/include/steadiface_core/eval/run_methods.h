@@ -1,0 +1,34 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "steadiface_core/eval/scorecard.h"
+#include "steadiface_core/pipeline.h"
+#include "steadiface_core/sim/simulator.h"
+
+namespace steadiface {
+namespace eval {
+
+/// A stabilization method to score on simulated sequences.
+enum class Method {
+  kNone,        ///< input as is
+  kGyroOnly,    ///< steadiface with w_f = 0 (no face)
+  kSteadiface,  ///< the full method, dlib landmarks from the rendered frames
+};
+const char* MethodName(Method m);
+
+/// Pipeline options matching a simulator (intrinsics, readout, IMU clock
+/// offset) with the package defaults otherwise.
+PipelineOptions OptionsFor(const sim::Simulator& sim, Method method);
+
+/// Renders every frame, feeds the IMU and the frames through a Pipeline
+/// (render_output off unless `render`), and scores the warps. Fills
+/// `score` and `card` (for trajectories); `frames_out` (optional) receives
+/// the stabilizer frames.
+Status RunMethod(const sim::Simulator& sim, Method method,
+                 const PipelineOptions& options, bool render,
+                 Scorecard* card, std::vector<StabilizerFrame>* frames_out);
+
+}  // namespace eval
+}  // namespace steadiface

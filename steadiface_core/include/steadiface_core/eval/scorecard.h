@@ -1,0 +1,120 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "steadiface_core/camera_model.h"
+#include "steadiface_core/output_geometry.h"
+#include "steadiface_core/protrusion.h"
+#include "steadiface_core/row_rotations.h"
+#include "steadiface_core/sim/simulator.h"
+
+namespace steadiface {
+namespace eval {
+
+/// The warp a stabilizer applied to one frame, in one of three forms.
+struct FrameWarp {
+  enum class Kind {
+    kIdentity,    ///< no stabilization: output = input
+    kPose,        ///< steadiface: virtual pose + per-row real rotation
+    kHomography,  ///< any per-frame homography (input px -> output px)
+  };
+  Kind kind = Kind::kIdentity;
+  Eigen::Quaterniond R_v = Eigen::Quaterniond::Identity();
+  Eigen::Vector2d t = Eigen::Vector2d::Zero();
+  RowRotations rows;
+  Eigen::Matrix3d H = Eigen::Matrix3d::Identity();
+  /// Per-stage time of this frame [ms] (name, value); optional.
+  std::vector<std::pair<std::string, double>> stage_ms;
+};
+
+/// The numbers of one method on one sequence.
+struct Score {
+  int frames = 0;
+  /// RMS of the > highpass_hz part of the output head-centre trajectory
+  /// [output px] and as a fraction of the output diagonal.
+  double head_jitter_px = 0.0, head_jitter_frac = 0.0;
+  /// The same for far-background points (mean over the points).
+  double background_jitter_px = 0.0, background_jitter_frac = 0.0;
+  /// Liu et al. 2013 stability: energy in the 2nd-6th lowest frequency bins
+  /// of the frame-to-frame motion over its total energy, excluding DC
+  /// (1 = perfectly smooth), for the head and the background.
+  double head_stability = 0.0, background_stability = 0.0;
+  /// Output area over input area (1 = no crop).
+  double cropping = 1.0;
+  /// Min over frames of the ratio of the smaller to the larger singular
+  /// value of the warp's local linear part at the output centre (1 = no
+  /// distortion).
+  double distortion = 1.0;
+  /// Fraction of frames with any undefined output pixel.
+  double undefined_fraction = 0.0;
+  /// Per-stage time, median and p99 [ms].
+  std::vector<std::pair<std::string, std::pair<double, double>>> stage_ms;
+};
+
+struct ScorecardOptions {
+  /// High-pass cut-off for jitter [Hz].
+  double highpass_hz = 0.5;
+};
+
+/// Evaluates any stabilizer's per-frame warps against a simulated
+/// sequence's ground truth (the true head centre and true far-background
+/// directions, mapped through each frame's warp).
+class Scorecard {
+ public:
+  /// `model` and `output` describe kPose warps (the stabilizer's camera and
+  /// output geometry); `output_width/height` is the output image size of
+  /// every method (for kIdentity: the input size).
+  Scorecard(const sim::Simulator& sim, const CameraModel& model,
+            const OutputGeometry& output, const ScorecardOptions& options);
+
+  /// Adds frame `index` of the sequence with the warp applied to it.
+  void Add(int index, const FrameWarp& warp);
+
+  Score Compute() const;
+
+  /// Trajectories for plots: per added frame, the stamp [s], the true head
+  /// centre in the input and in the output [px] (NaN when out of view), and
+  /// the first background point in the output.
+  struct Sample {
+    double t = 0.0;
+    Eigen::Vector2d head_in, head_out, background_out;
+    bool head_valid = false;
+    double virtual_angle[3] = {0, 0, 0};  // rotation vector of R_v (rad)
+    double real_angle[3] = {0, 0, 0};     // rotation vector of R_r (rad)
+    Eigen::Vector2d offset = Eigen::Vector2d::Zero();  // t
+  };
+  const std::vector<Sample>& samples() const { return samples_; }
+
+  /// High-pass RMS of a 2D trajectory (linear trend removed, FFT bins under
+  /// `cutoff_hz` zeroed) [same units]; exposed for tests.
+  static double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
+                            double cutoff_hz);
+  /// Liu et al. stability of a 2D trajectory's frame-to-frame motion.
+  static double Stability(const std::vector<Eigen::Vector2d>& x);
+
+ private:
+  bool MapToOutput(const FrameWarp& w, const Eigen::Vector2d& in_px,
+                   Eigen::Vector2d* out_px) const;
+
+  const sim::Simulator& sim_;
+  const CameraModel model_;
+  const OutputGeometry output_;
+  const ProtrusionGeometry protrusion_;
+  const ScorecardOptions options_;
+  std::vector<Eigen::Vector3d> background_dirs_;
+  std::vector<Sample> samples_;
+  std::vector<std::vector<Eigen::Vector2d>> background_out_;  // [point][frame]
+  std::vector<Eigen::Vector2d> head_out_;
+  std::vector<bool> head_valid_;
+  std::vector<double> distortion_;
+  int undefined_ = 0;
+  bool identity_ = true;
+  std::vector<std::pair<std::string, std::vector<double>>> stages_;
+};
+
+}  // namespace eval
+}  // namespace steadiface

@@ -1,0 +1,114 @@
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/camera_model.h"
+#include "steadiface_core/face/face_tracker.h"
+#include "steadiface_core/orientation_timeline.h"
+#include "steadiface_core/rolling_shutter.h"
+#include "steadiface_core/stabilizer/stabilizer.h"
+#include "steadiface_core/status.h"
+#include "steadiface_core/warper.h"
+
+namespace steadiface {
+
+/// Where landmarks come from.
+enum class LandmarkSource {
+  kDlib,      ///< the built-in detector + dlib 68-point tracker
+  kExternal,  ///< landmarks supplied with each frame (another node)
+  kNone,      ///< no face processing: gyro-only stabilization
+};
+
+/// All options of one stream.
+struct PipelineOptions {
+  CameraModelOptions camera;
+  RollingShutterOptions shutter;
+  OrientationTimelineOptions imu;
+  LandmarkSource landmark_source = LandmarkSource::kDlib;
+  FaceTrackerOptions face;
+  StabilizerOptions stabilizer;
+  WarpOptions warp;
+  /// Produce the stabilized image (false: poses only, e.g. for scoring).
+  bool render_output = true;
+};
+
+Status ValidatePipelineOptions(const PipelineOptions& options);
+
+struct PipelineTimings {
+  double face_ms = 0.0;
+  double stabilizer_ms = 0.0;
+  double mesh_ms = 0.0;
+  double maps_ms = 0.0;
+  double remap_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+/// One processed frame.
+struct PipelineFrame {
+  FaceInfo face;
+  StabilizerFrame stabilizer;
+  /// Stabilized, cropped, scaled output (empty when render_output is off or
+  /// the warp refused the pose).
+  cv::Mat output;
+  /// Intrinsics of `output` (virtual focal and principal offset).
+  CameraIntrinsics output_intrinsics;
+  PipelineTimings timings;
+};
+
+/// The whole per-frame chain for one camera + IMU stream: gyro timeline,
+/// face information, stabilizer and warp (product steps 1-5). The ROS
+/// nodelet, the offline bag tool and the evaluation tools all drive this
+/// one class; the ROS layer only converts messages.
+///
+/// Causal and deterministic. Not thread-safe: the owner serializes calls.
+class Pipeline {
+ public:
+  static Status Create(const CameraIntrinsics& intrinsics,
+                       const PipelineOptions& options,
+                       std::unique_ptr<Pipeline>* out);
+
+  /// Buffers one gyro sample (rejections are counted in timeline stats).
+  SampleResult AddGyro(const GyroSample& sample);
+
+  /// True when the gyro covers the frame's last row (plus nothing else is
+  /// needed to process it).
+  bool GyroCovers(Time stamp) const;
+  /// Capture time of the frame's last row (camera clock).
+  Time LastRowTime(Time stamp) const { return timing_.LastRowTime(stamp); }
+
+  /// Processes one frame. `external_landmarks` (raw pixels, 68 points, may
+  /// be empty = no face) is used with LandmarkSource::kExternal.
+  Status ProcessFrame(const cv::Mat& image, Time stamp,
+                      const std::vector<Eigen::Vector2d>* external_landmarks,
+                      double external_confidence, PipelineFrame* out);
+
+  /// Replaces the stabilizer's tunable options from the next frame on.
+  Status UpdateStabilizerOptions(const StabilizerOptions& options);
+
+  /// Time jumped back: forget gyro, face lock and trajectory.
+  void Reset();
+
+  const OrientationTimeline& timeline() const { return timeline_; }
+  const Stabilizer& stabilizer() const { return *stabilizer_; }
+  const Warper& warper() const { return *warper_; }
+  const CameraModel& camera_model() const { return model_; }
+  const RowTiming& row_timing() const { return timing_; }
+  const PipelineOptions& options() const { return options_; }
+
+ private:
+  Pipeline(const CameraModel& model, const PipelineOptions& options);
+
+  const CameraModel model_;
+  PipelineOptions options_;
+  const RowTiming timing_;
+  OrientationTimeline timeline_;
+  std::unique_ptr<FaceTracker> tracker_;
+  std::unique_ptr<Stabilizer> stabilizer_;
+  std::unique_ptr<Warper> warper_;
+};
+
+}  // namespace steadiface

@@ -1,0 +1,152 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/camera_intrinsics.h"
+#include "steadiface_core/orientation_timeline.h"
+#include "steadiface_core/rolling_shutter.h"
+#include "steadiface_core/sim/motion.h"
+#include "steadiface_core/sim/scene_renderer.h"
+#include "steadiface_core/status.h"
+
+namespace steadiface {
+namespace sim {
+
+/// Everything that defines a simulated selfie sequence. ApplyPreset() fills
+/// it for the named presets; every field can be overridden afterwards.
+struct SimulatorOptions {
+  /// Image size [px], frame rate [Hz], duration [s], horizontal FOV [rad].
+  int width = 640, height = 360;
+  double fps = 30.0;
+  double duration_s = 3.0;
+  double hfov_rad = 1.1;
+  /// Rolling-shutter readout [s]; frames are stamped at the first row.
+  double readout_s = 0.02;
+  /// Rows per rendered band (each band is rendered with its own pose).
+  int band_rows = 8;
+  uint64_t seed = 1;
+  /// Data folder with astronaut.png, building.jpg and gyro/ (test/data).
+  std::string data_dir;
+  std::string face_photo = "astronaut.png";
+  std::string background_photo = "building.jpg";
+  /// Head region cropped from the face photo onto the billboard, the
+  /// landmark centre inside the photo and the face width there [px]
+  /// (defaults: astronaut.png, from dlib's 68 landmarks).
+  cv::Rect face_region = cv::Rect(139, 38, 168, 188);
+  Eigen::Vector2d face_centre_px = Eigen::Vector2d(224.1, 127.4);
+  double face_width_px = 88.0;
+  /// Camera motion: parametric (pan + band-limited shake + translation) ...
+  CameraMotionOptions camera;
+  /// ... or the real recorded gyro trace (data_dir/gyro), scaled by
+  /// real_gyro_scale, replacing the parametric rotation.
+  bool use_real_gyro = false;
+  /// The pan turns the person too: camera and head orbit the head's base
+  /// position together (a vlogger turning with the phone at arm's length),
+  /// so the face stays in view while the background pans.
+  bool pan_orbits_head = true;
+  double real_gyro_scale = 1.0;
+  /// Head motion relative to the body, and the body's walking motion shared
+  /// by camera and head [m, Hz].
+  HeadMotionOptions head;
+  double body_bob_m = 0.02, body_sway_m = 0.01, body_bob_hz = 1.8;
+  /// Face width on the billboard [m].
+  double face_width_m = 0.15;
+  /// IMU: gyro rate [Hz], white noise [rad/s], constant bias [rad/s],
+  /// timestamp jitter (std) [s], clock offset: IMU stamps are true time
+  /// minus this, so the stabilizer's imu_time_offset must be +this [s].
+  double imu_rate_hz = 200.0;
+  double gyro_noise = 0.002;
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d(0.001, -0.0015, 0.0005);
+  double imu_jitter_s = 0.0002;
+  double imu_clock_offset_s = 0.0;
+  /// Events (times in seconds from the start; negative = never).
+  double occlusion_start_s = -1, occlusion_end_s = -1;
+  double face_out_start_s = -1, face_out_end_s = -1;
+  double second_face_start_s = -1;
+  /// The second face grows (walks closer) from 1.2 m to this distance [m].
+  double second_face_final_distance_m = 1.2;
+  double brightness_change_s = -1;
+  double brightness_gain = 1.6;
+};
+
+/// Presets: still, walk, pan, run, occlusion, two_faces, turn_away.
+Status ApplyPreset(const std::string& name, SimulatorOptions* options);
+const std::vector<std::string>& PresetNames();
+
+/// Ground truth of one frame.
+struct SimTruth {
+  Time stamp;  ///< first-row capture time
+  /// True real rotation (world -> camera) at `rotation_rows` rows.
+  std::vector<double> rotation_rows;
+  std::vector<Eigen::Quaterniond> R_r;
+  /// True head centre in the image [px] (the face photo's landmark centre
+  /// on the billboard, projected at its own row) and whether it is in view.
+  Eigen::Vector2d head_px = Eigen::Vector2d::Zero();
+  bool head_in_view = false;
+  /// Face width in the image [px].
+  double face_scale_px = 0.0;
+  /// Events active in this frame.
+  bool occluded = false, face_out = false, second_face = false,
+       brightness_changed = false;
+};
+
+/// Renders frames and IMU with exact ground truth (issue: simulator).
+/// Deterministic: the same options give byte-identical frames, IMU and
+/// truth.
+class Simulator {
+ public:
+  static Status Create(const SimulatorOptions& options,
+                       std::unique_ptr<Simulator>* out);
+
+  int num_frames() const { return num_frames_; }
+  const CameraIntrinsics& intrinsics() const { return intrinsics_; }
+  const RowTiming& timing() const { return timing_; }
+  /// Gyro samples as the IMU reports them (camera axes, IMU clock).
+  const std::vector<GyroSample>& imu() const { return imu_; }
+  const SimulatorOptions& options() const { return options_; }
+
+  /// Renders frame i (BGR) and its truth.
+  Status Render(int i, cv::Mat* bgr, SimTruth* truth) const;
+  /// Truth only (fast).
+  SimTruth Truth(int i) const;
+
+  /// True camera-to-world pose at time t [s].
+  Pose CameraPose(double t) const;
+  /// Where a world direction at infinity appears in frame i [px], at its
+  /// own row. False when behind the camera.
+  bool BackgroundPixel(int i, const Eigen::Vector3d& direction,
+                       Eigen::Vector2d* px) const;
+
+ private:
+  explicit Simulator(const SimulatorOptions& options);
+  Status Init();
+  Eigen::Vector3d Body(double t) const;
+  /// Applies the pan orbit (if any) to a world pose.
+  Pose Orbit(const Pose& P, double t) const;
+  double RowTimeS(Time stamp, double y) const;
+  Time Stamp(int i) const;
+
+  SimulatorOptions options_;
+  CameraIntrinsics intrinsics_;
+  RowTiming timing_;
+  int num_frames_ = 0;
+  CameraMotion camera_;
+  HeadMotion head_;
+  std::unique_ptr<OrientationTimeline> real_gyro_;  // when use_real_gyro
+  std::unique_ptr<InfiniteBackground> background_;
+  Billboard face_, second_face_, occluder_;
+  Eigen::Vector2d face_centre_uv_ = Eigen::Vector2d::Zero();
+  std::vector<GyroSample> imu_;
+};
+
+/// Loads a deepfvs gyro log ("t_us gx gy gz ...") as camera-frame samples
+/// (omega_cam = (g_y, g_x, -g_z)), with times relative to the first sample.
+Status LoadDeepFvsGyro(const std::string& path, std::vector<GyroSample>* out);
+
+}  // namespace sim
+}  // namespace steadiface

@@ -1,0 +1,82 @@
+#include "steadiface_core/eval/run_methods.h"
+
+namespace steadiface {
+namespace eval {
+
+const char* MethodName(Method m) {
+  switch (m) {
+    case Method::kNone:
+      return "none";
+    case Method::kGyroOnly:
+      return "gyro-only";
+    case Method::kSteadiface:
+      return "steadiface";
+  }
+  return "?";
+}
+
+PipelineOptions OptionsFor(const sim::Simulator& sim, Method method) {
+  PipelineOptions o;
+  o.shutter.readout_time_s = sim.options().readout_s;
+  o.shutter.stamp = StampConvention::kFirstRow;
+  o.imu.imu_time_offset_s = sim.options().imu_clock_offset_s;
+  o.landmark_source =
+      method == Method::kSteadiface ? LandmarkSource::kDlib : LandmarkSource::kNone;
+  o.stabilizer.gyro_only = method != Method::kSteadiface;
+  o.render_output = false;
+  return o;
+}
+
+Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions& options,
+                 bool render, Scorecard* card, std::vector<StabilizerFrame>* frames_out) {
+  if (method == Method::kNone) {
+    for (int i = 0; i < sim.num_frames(); ++i) card->Add(i, FrameWarp());
+    return Status::Ok();
+  }
+  PipelineOptions o = options;
+  o.render_output = render;
+  std::unique_ptr<Pipeline> p;
+  Status s = Pipeline::Create(sim.intrinsics(), o, &p);
+  if (!s.ok()) return s;
+  size_t g = 0;
+  const auto& imu = sim.imu();
+  cv::Mat frame;
+  sim::SimTruth truth;
+  for (int i = 0; i < sim.num_frames(); ++i) {
+    const Time stamp = sim.Truth(i).stamp;
+    // IMU up to just past the frame's last row, as a live node would have.
+    const Time need = p->LastRowTime(stamp);
+    while (g < imu.size() &&
+           (!p->GyroCovers(stamp) ||
+            imu[g].stamp + FromSeconds(o.imu.imu_time_offset_s) <= need)) {
+      p->AddGyro(imu[g++]);
+    }
+    if (method == Method::kSteadiface || render) {
+      s = sim.Render(i, &frame, &truth);
+      if (!s.ok()) return s;
+    } else {
+      frame = cv::Mat(sim.intrinsics().height, sim.intrinsics().width, CV_8UC1,
+                      cv::Scalar(0));
+    }
+    PipelineFrame out;
+    s = p->ProcessFrame(frame, stamp, nullptr, 0.0, &out);
+    if (!s.ok()) return Status::Error("frame " + std::to_string(i) + ": " + s.message());
+    FrameWarp w;
+    w.kind = FrameWarp::Kind::kPose;
+    w.R_v = out.stabilizer.R_v;
+    w.t = out.stabilizer.t;
+    w.rows = out.stabilizer.rows;
+    w.stage_ms = {{"face", out.timings.face_ms},
+                  {"stabilizer", out.timings.stabilizer_ms},
+                  {"solver", out.stabilizer.solver.time_ms}};
+    if (render) {
+      w.stage_ms.push_back({"warp", out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms});
+    }
+    card->Add(i, w);
+    if (frames_out != nullptr) frames_out->push_back(out.stabilizer);
+  }
+  return Status::Ok();
+}
+
+}  // namespace eval
+}  // namespace steadiface

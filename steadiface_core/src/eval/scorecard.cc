@@ -1,0 +1,253 @@
+#include "steadiface_core/eval/scorecard.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/so3.h"
+
+namespace steadiface {
+namespace eval {
+namespace {
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
+}
+
+// Power spectrum of a real series (DFT), bins 0..n/2.
+std::vector<double> Power(const std::vector<double>& x) {
+  cv::Mat in(1, static_cast<int>(x.size()), CV_64F), out;
+  for (size_t i = 0; i < x.size(); ++i) in.at<double>(0, static_cast<int>(i)) = x[i];
+  cv::dft(in, out, cv::DFT_COMPLEX_OUTPUT);
+  std::vector<double> p(x.size() / 2 + 1);
+  for (size_t k = 0; k < p.size(); ++k) {
+    const cv::Vec2d c = out.at<cv::Vec2d>(0, static_cast<int>(k));
+    p[k] = c[0] * c[0] + c[1] * c[1];
+  }
+  return p;
+}
+
+}  // namespace
+
+double Scorecard::HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
+                              double cutoff_hz) {
+  const int n = static_cast<int>(x.size());
+  if (n < 4) return 0.0;
+  double total = 0.0;
+  for (int axis = 0; axis < 2; ++axis) {
+    // Remove the linear trend (least squares).
+    double st = 0, sx = 0, stt = 0, stx = 0;
+    for (int i = 0; i < n; ++i) {
+      st += i;
+      sx += x[i][axis];
+      stt += double(i) * i;
+      stx += i * x[i][axis];
+    }
+    const double b = (n * stx - st * sx) / (n * stt - st * st);
+    const double a = (sx - b * st) / n;
+    cv::Mat in(1, n, CV_64F), spec, back;
+    for (int i = 0; i < n; ++i) in.at<double>(0, i) = x[i][axis] - (a + b * i);
+    cv::dft(in, spec, cv::DFT_COMPLEX_OUTPUT);
+    for (int k = 0; k < n; ++k) {
+      const int kk = std::min(k, n - k);
+      const double f = kk * fps / n;
+      if (f < cutoff_hz) spec.at<cv::Vec2d>(0, k) = cv::Vec2d(0, 0);
+    }
+    cv::dft(spec, back, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+    for (int i = 0; i < n; ++i) total += back.at<double>(0, i) * back.at<double>(0, i);
+  }
+  return std::sqrt(total / n);
+}
+
+double Scorecard::Stability(const std::vector<Eigen::Vector2d>& x) {
+  if (x.size() < 16) return 0.0;
+  double score = 0.0;
+  for (int axis = 0; axis < 2; ++axis) {
+    std::vector<double> d;
+    for (size_t i = 1; i < x.size(); ++i) d.push_back(x[i][axis] - x[i - 1][axis]);
+    const std::vector<double> p = Power(d);
+    double low = 0.0, all = 0.0;
+    for (size_t k = 1; k < p.size(); ++k) {
+      all += p[k];
+      if (k >= 1 && k <= 5) low += p[k];  // 2nd-6th lowest bins (DC is the 1st)
+    }
+    score += all > 0 ? low / all : 1.0;
+  }
+  return 0.5 * score;
+}
+
+Scorecard::Scorecard(const sim::Simulator& sim, const CameraModel& model,
+                     const OutputGeometry& output, const ScorecardOptions& options)
+    : sim_(sim),
+      model_(model),
+      output_(output),
+      protrusion_(model, output, 16),
+      options_(options) {
+  // Far-background directions: a grid over the views the camera sweeps
+  // (several along a pan); each is scored on its longest in-view run.
+  const double T = sim.options().duration_s;
+  for (double f : {0.1, 0.5, 0.9}) {
+    const Eigen::Quaterniond R = sim.CameraPose(f * T).R;
+    for (double y : {-0.15, 0.0, 0.15}) {
+      for (double x : {-0.25, 0.0, 0.25}) {
+        background_dirs_.push_back(R * Eigen::Vector3d(x, y, 1.0));
+      }
+    }
+  }
+  background_out_.resize(background_dirs_.size());
+}
+
+bool Scorecard::MapToOutput(const FrameWarp& w, const Eigen::Vector2d& p,
+                            Eigen::Vector2d* out) const {
+  switch (w.kind) {
+    case FrameWarp::Kind::kIdentity:
+      *out = p;
+      return true;
+    case FrameWarp::Kind::kHomography: {
+      const Eigen::Vector3d q = w.H * p.homogeneous();
+      if (std::abs(q.z()) < 1e-12) return false;
+      *out = q.hnormalized();
+      return true;
+    }
+    case FrameWarp::Kind::kPose: {
+      Eigen::Vector2d V;
+      if (!model_.Project(model_.PixelToNormalized(p), w.R_v, w.t, w.rows.At(p.y()), &V)) {
+        return false;
+      }
+      *out = output_.VirtualToOutputPixel(V);
+      return true;
+    }
+  }
+  return false;
+}
+
+void Scorecard::Add(int index, const FrameWarp& w) {
+  const sim::SimTruth truth = sim_.Truth(index);
+  Sample s;
+  s.t = ToSeconds(truth.stamp);
+  s.head_in = truth.head_px;
+  s.head_valid = truth.head_in_view && MapToOutput(w, truth.head_px, &s.head_out);
+  if (!s.head_valid) s.head_out = Eigen::Vector2d::Constant(NAN);
+  head_out_.push_back(s.head_out);
+  head_valid_.push_back(s.head_valid);
+  const CameraIntrinsics& ki = sim_.intrinsics();
+  for (size_t k = 0; k < background_dirs_.size(); ++k) {
+    Eigen::Vector2d px, o = Eigen::Vector2d::Constant(NAN);
+    if (sim_.BackgroundPixel(index, background_dirs_[k], &px) && px.x() >= 0 &&
+        px.y() >= 0 && px.x() <= ki.width - 1 && px.y() <= ki.height - 1) {
+      MapToOutput(w, px, &o);
+    }
+    background_out_[k].push_back(o);
+    if (k == 13) s.background_out = o;  // centre of the middle view
+  }
+  if (w.kind != FrameWarp::Kind::kIdentity) identity_ = false;
+  // Distortion: local linear part at the output centre, via the input point
+  // that lands there (numerically).
+  double ratio = 1.0;
+  if (w.kind != FrameWarp::Kind::kIdentity) {
+    const Eigen::Vector2d c(0.5 * (sim_.intrinsics().width - 1), 0.5 * (sim_.intrinsics().height - 1));
+    Eigen::Vector2d o0, ox, oy;
+    const double h = 1.0;
+    if (MapToOutput(w, c, &o0) && MapToOutput(w, c + Eigen::Vector2d(h, 0), &ox) &&
+        MapToOutput(w, c + Eigen::Vector2d(0, h), &oy)) {
+      Eigen::Matrix2d J;
+      J.col(0) = (ox - o0) / h;
+      J.col(1) = (oy - o0) / h;
+      Eigen::JacobiSVD<Eigen::Matrix2d> svd(J);
+      const auto sv = svd.singularValues();
+      ratio = sv(0) > 0 ? sv(1) / sv(0) : 0.0;
+    } else {
+      ratio = 0.0;
+    }
+  }
+  distortion_.push_back(ratio);
+  // Undefined output pixels.
+  bool undefined = false;
+  if (w.kind == FrameWarp::Kind::kPose) {
+    undefined = !protrusion_.Check(w.R_v, w.t, w.rows, 0.0).defined;
+    const Eigen::Vector3d v = LogSO3(w.R_v), r = LogSO3(w.rows.Middle());
+    for (int i = 0; i < 3; ++i) {
+      s.virtual_angle[i] = v[i];
+      s.real_angle[i] = r[i];
+    }
+    s.offset = w.t;
+  } else if (w.kind == FrameWarp::Kind::kHomography) {
+    const Eigen::Matrix3d Hi = w.H.inverse();
+    const double W = sim_.intrinsics().width - 1, Hh = sim_.intrinsics().height - 1;
+    for (int i = 0; i <= 20 && !undefined; ++i) {
+      const double f = i / 20.0;
+      for (const Eigen::Vector2d& q : {Eigen::Vector2d(f * W, 0), Eigen::Vector2d(f * W, Hh),
+                                       Eigen::Vector2d(0, f * Hh), Eigen::Vector2d(W, f * Hh)}) {
+        const Eigen::Vector2d p = (Hi * q.homogeneous()).hnormalized();
+        if (!(p.x() >= 0 && p.y() >= 0 && p.x() <= W && p.y() <= Hh)) undefined = true;
+      }
+    }
+  }
+  undefined_ += undefined;
+  for (const auto& st : w.stage_ms) {
+    auto it = std::find_if(stages_.begin(), stages_.end(),
+                           [&](const auto& e) { return e.first == st.first; });
+    if (it == stages_.end()) {
+      stages_.push_back({st.first, {}});
+      it = stages_.end() - 1;
+    }
+    it->second.push_back(st.second);
+  }
+  samples_.push_back(s);
+}
+
+Score Scorecard::Compute() const {
+  Score sc;
+  sc.frames = static_cast<int>(samples_.size());
+  if (sc.frames == 0) return sc;
+  const double fps = sim_.options().fps;
+  const bool pose = !identity_;
+  const double out_w = identity_ ? sim_.intrinsics().width : output_.width();
+  const double out_h = identity_ ? sim_.intrinsics().height : output_.height();
+  const double diag = std::hypot(out_w, out_h);
+  // Jitter needs a contiguous series: each trajectory is scored on its
+  // longest run of finite samples.
+  auto longest_run = [](const std::vector<Eigen::Vector2d>& x) {
+    std::vector<Eigen::Vector2d> run, best;
+    for (size_t i = 0; i <= x.size(); ++i) {
+      if (i < x.size() && x[i].allFinite()) {
+        run.push_back(x[i]);
+      } else {
+        if (run.size() > best.size()) best = run;
+        run.clear();
+      }
+    }
+    return best;
+  };
+  const std::vector<Eigen::Vector2d> head = longest_run(head_out_);
+  sc.head_jitter_px = HighPassRms(head, fps, options_.highpass_hz);
+  sc.head_jitter_frac = sc.head_jitter_px / diag;
+  sc.head_stability = Stability(head);
+  double bg = 0.0, bg_stab = 0.0;
+  int nbg = 0;
+  const size_t min_run = static_cast<size_t>(std::max(16.0, fps));  // >= 1 s
+  for (const auto& traj : background_out_) {
+    const std::vector<Eigen::Vector2d> r = longest_run(traj);
+    if (r.size() < min_run) continue;
+    bg += HighPassRms(r, fps, options_.highpass_hz);
+    bg_stab += Stability(r);
+    ++nbg;
+  }
+  sc.background_jitter_px = nbg ? bg / nbg : NAN;
+  sc.background_jitter_frac = sc.background_jitter_px / diag;
+  sc.background_stability = nbg ? bg_stab / nbg : NAN;
+  sc.cropping = pose ? std::pow(1.0 - 2.0 * output_.crop_ratio(), 2.0) : 1.0;
+  sc.distortion = *std::min_element(distortion_.begin(), distortion_.end());
+  sc.undefined_fraction = static_cast<double>(undefined_) / sc.frames;
+  for (const auto& st : stages_) {
+    sc.stage_ms.push_back({st.first, {Percentile(st.second, 0.5), Percentile(st.second, 0.99)}});
+  }
+  return sc;
+}
+
+}  // namespace eval
+}  // namespace steadiface

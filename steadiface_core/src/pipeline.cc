@@ -1,0 +1,140 @@
+#include "steadiface_core/pipeline.h"
+
+#include <chrono>
+
+namespace steadiface {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t)
+      .count();
+}
+
+}  // namespace
+
+Status ValidatePipelineOptions(const PipelineOptions& o) {
+  Status s = ValidateCameraModelOptions(o.camera);
+  if (!s.ok()) return s;
+  s = ValidateRollingShutterOptions(o.shutter);
+  if (!s.ok()) return s;
+  s = ValidateOrientationTimelineOptions(o.imu);
+  if (!s.ok()) return s;
+  if (o.landmark_source == LandmarkSource::kDlib) {
+    s = ValidateFaceTrackerOptions(o.face);
+    if (!s.ok()) return s;
+  }
+  s = ValidateStabilizerOptions(o.stabilizer);
+  if (!s.ok()) return s;
+  return ValidateWarpOptions(o.warp);
+}
+
+Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
+    : model_(model),
+      options_(options),
+      timing_(options.shutter, model.intrinsics().height),
+      timeline_(options.imu) {}
+
+Status Pipeline::Create(const CameraIntrinsics& intrinsics,
+                        const PipelineOptions& options,
+                        std::unique_ptr<Pipeline>* out) {
+  Status s = ValidatePipelineOptions(options);
+  if (!s.ok()) return s;
+  CameraModel model;
+  s = CameraModel::Create(intrinsics, options.camera, &model);
+  if (!s.ok()) return s;
+  std::unique_ptr<Pipeline> p(new Pipeline(model, options));
+  if (options.landmark_source != LandmarkSource::kNone) {
+    // External landmarks still go through the tracker's checks and
+    // face-of-interest logic (no model file needed for them, but the
+    // tracker loads it; a missing file is an error only for kDlib).
+    FaceTrackerOptions fo = options.face;
+    s = FaceTracker::Create(model, fo, &p->tracker_);
+    if (!s.ok()) return s;
+  }
+  s = Stabilizer::Create(model, options.warp.output, options.stabilizer,
+                         &p->stabilizer_);
+  if (!s.ok()) return s;
+  s = Warper::Create(model, options.warp, &p->warper_);
+  if (!s.ok()) return s;
+  *out = std::move(p);
+  return Status::Ok();
+}
+
+SampleResult Pipeline::AddGyro(const GyroSample& sample) {
+  return timeline_.AddSample(sample);
+}
+
+bool Pipeline::GyroCovers(Time stamp) const {
+  return timeline_.Covers(timing_.FirstRowTime(stamp)) &&
+         timeline_.Covers(timing_.LastRowTime(stamp));
+}
+
+Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
+                              const std::vector<Eigen::Vector2d>* external,
+                              double external_confidence, PipelineFrame* out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const CameraIntrinsics& k = model_.intrinsics();
+  if (image.empty() || image.cols != k.width || image.rows != k.height ||
+      image.depth() != CV_8U || image.channels() < 1 || image.channels() > 4) {
+    return Status::Error("pipeline: image must be 8-bit, 1-4 channels, " +
+                         std::to_string(k.width) + "x" + std::to_string(k.height));
+  }
+  PipelineFrame f;
+  // Face information.
+  const auto t_face = std::chrono::steady_clock::now();
+  const FaceObservation* obs = nullptr;
+  FaceObservation observation;
+  if (tracker_ != nullptr) {
+    Status s;
+    if (options_.landmark_source == LandmarkSource::kExternal) {
+      static const std::vector<Eigen::Vector2d> kNone;
+      s = tracker_->ProcessExternal(external != nullptr ? *external : kNone,
+                                    external_confidence, stamp, &timeline_, &timing_,
+                                    &f.face);
+    } else {
+      s = tracker_->Process(image, stamp, &timeline_, &timing_, &f.face);
+    }
+    // A face error never stops stabilization: it is a frame without a face.
+    if (f.face.valid) {
+      observation = f.face.ToObservation();
+      obs = &observation;
+    }
+  }
+  f.timings.face_ms = MsSince(t_face);
+  // Stabilizer.
+  const auto t_stab = std::chrono::steady_clock::now();
+  Status s = stabilizer_->Process(stamp, timeline_, timing_, obs, &f.stabilizer);
+  f.timings.stabilizer_ms = MsSince(t_stab);
+  if (!s.ok()) return s;
+  // Warp.
+  f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(f.stabilizer.t);
+  if (options_.render_output) {
+    s = warper_->Warp(image, f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows,
+                      &f.output);
+    f.timings.mesh_ms = warper_->timings().mesh_ms;
+    f.timings.maps_ms = warper_->timings().maps_ms;
+    f.timings.remap_ms = warper_->timings().remap_ms;
+    if (!s.ok()) {
+      f.output.release();
+      *out = std::move(f);
+      return s;
+    }
+  }
+  f.timings.total_ms = MsSince(t0);
+  *out = std::move(f);
+  return Status::Ok();
+}
+
+Status Pipeline::UpdateStabilizerOptions(const StabilizerOptions& options) {
+  Status s = stabilizer_->UpdateOptions(options);
+  if (s.ok()) options_.stabilizer = options;
+  return s;
+}
+
+void Pipeline::Reset() {
+  timeline_.reset();
+  if (tracker_ != nullptr) tracker_->reset();
+  stabilizer_->reset();
+}
+
+}  // namespace steadiface

@@ -1,0 +1,346 @@
+#include "steadiface_core/sim/simulator.h"
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "steadiface_core/so3.h"
+
+namespace steadiface {
+namespace sim {
+namespace {
+
+// 0 before a, 1 after b, smooth in between.
+double Ramp(double t, double a, double b) {
+  if (t <= a) return 0.0;
+  if (t >= b) return 1.0;
+  const double s = (t - a) / (b - a);
+  return s * s * (3 - 2 * s);
+}
+
+bool Active(double t, double start, double end) {
+  return start >= 0 && t >= start && (end < 0 || t < end);
+}
+
+}  // namespace
+
+const std::vector<std::string>& PresetNames() {
+  static const std::vector<std::string> names = {
+      "still", "walk", "pan", "run", "occlusion", "two_faces", "turn_away"};
+  return names;
+}
+
+Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
+  // Shared walking-selfie base.
+  auto walk = [o]() {
+    o->camera.shake_rms_rad = 0.012;
+    o->camera.translation_rms_m = 0.002;
+    o->camera.pan_rate = 0.0;
+    o->body_bob_m = 0.02;
+    o->body_sway_m = 0.01;
+  };
+  if (name == "still") {
+    o->camera.shake_rms_rad = 0.0;
+    o->camera.translation_rms_m = 0.0;
+    o->body_bob_m = o->body_sway_m = 0.0;
+    o->head.bob_amplitude_m = 0.01;
+    o->head.sway_amplitude_m = 0.012;
+  } else if (name == "walk") {
+    walk();
+  } else if (name == "pan") {
+    o->camera.shake_rms_rad = 0.004;
+    o->camera.translation_rms_m = 0.001;
+    o->camera.pan_rate = 0.2;
+    o->body_bob_m = o->body_sway_m = 0.0;
+  } else if (name == "run") {
+    walk();
+    o->use_real_gyro = true;
+    o->body_bob_m = 0.04;
+    o->body_bob_hz = 2.6;
+    o->camera.translation_rms_m = 0.004;
+  } else if (name == "occlusion") {
+    walk();
+    o->occlusion_start_s = 0.35 * o->duration_s;
+    o->occlusion_end_s = 0.6 * o->duration_s;
+  } else if (name == "two_faces") {
+    walk();
+    o->second_face_start_s = 0.25 * o->duration_s;
+    o->second_face_final_distance_m = 0.4;
+  } else if (name == "turn_away") {
+    walk();
+    o->head.yaw_amplitude_rad = 1.2;
+    o->head.yaw_hz = 0.5 / std::max(1.0, o->duration_s);
+  } else {
+    std::string all;
+    for (const auto& n : PresetNames()) all += " " + n;
+    return Status::Error("unknown preset '" + name + "'; presets:" + all);
+  }
+  return Status::Ok();
+}
+
+Status LoadDeepFvsGyro(const std::string& path, std::vector<GyroSample>* out) {
+  std::ifstream in(path);
+  if (!in) return Status::Error("cannot open gyro log '" + path + "'");
+  out->clear();
+  std::string line;
+  double t0 = -1;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    double t_us, gx, gy, gz;
+    if (!(ss >> t_us >> gx >> gy >> gz)) continue;
+    if (t0 < 0) t0 = t_us;
+    out->push_back({Time(FromSeconds((t_us - t0) * 1e-6)), Eigen::Vector3d(gy, gx, -gz)});
+  }
+  if (out->size() < 10) return Status::Error("gyro log '" + path + "' has too few samples");
+  return Status::Ok();
+}
+
+Simulator::Simulator(const SimulatorOptions& o)
+    : options_(o),
+      intrinsics_(IntrinsicsFromHorizontalFov(o.width, o.height, o.hfov_rad)),
+      timing_([&o] {
+        RollingShutterOptions rs;
+        rs.readout_time_s = o.readout_s;
+        return rs;
+      }(), o.height),
+      camera_([&o] {
+        CameraMotionOptions c = o.camera;
+        c.seed = o.seed * 7919 + 1;
+        return c;
+      }()),
+      head_([&o] {
+        HeadMotionOptions h = o.head;
+        h.seed = o.seed * 7919 + 2;
+        return h;
+      }()) {}
+
+Status Simulator::Create(const SimulatorOptions& options, std::unique_ptr<Simulator>* out) {
+  const SimulatorOptions& o = options;
+  if (o.width < 16 || o.height < 16 || o.width > 8192 || o.height > 8192) {
+    return Status::Error("sim: image size must be in [16, 8192] px");
+  }
+  if (!(o.fps > 0 && o.fps <= 1000) || !(o.duration_s > 0 && o.duration_s <= 3600) ||
+      !(o.hfov_rad > 0.1 && o.hfov_rad < 3.0) || !(o.readout_s >= 0 && o.readout_s < 0.2) ||
+      !(o.imu_rate_hz >= 10 && o.imu_rate_hz <= 10000) || o.band_rows < 1) {
+    return Status::Error("sim: fps, duration, hfov, readout, imu rate or band rows out of range");
+  }
+  std::unique_ptr<Simulator> s(new Simulator(options));
+  Status st = s->Init();
+  if (!st.ok()) return st;
+  *out = std::move(s);
+  return Status::Ok();
+}
+
+Status Simulator::Init() {
+  const SimulatorOptions& o = options_;
+  num_frames_ = static_cast<int>(std::floor(o.duration_s * o.fps + 1e-9));
+  const cv::Mat photo = cv::imread(o.data_dir + "/" + o.face_photo, cv::IMREAD_COLOR);
+  const cv::Mat bg = cv::imread(o.data_dir + "/" + o.background_photo, cv::IMREAD_COLOR);
+  if (photo.empty() || bg.empty()) {
+    return Status::Error("sim: cannot read " + o.data_dir + "/" + o.face_photo + " or " +
+                         o.background_photo);
+  }
+  background_.reset(new InfiniteBackground(bg, 0.8 * intrinsics_.fx));
+  const double m_per_px = o.face_width_m / o.face_width_px;
+  face_ = MakeFaceBillboard(photo, o.face_region, o.face_region.width * m_per_px);
+  face_centre_uv_ = o.face_centre_px - Eigen::Vector2d(o.face_region.x, o.face_region.y);
+  face_.pose = [this](double t) {
+    Pose P;
+    P.R = head_.Orientation(t);
+    P.p = head_.Position(t) + Body(t);
+    P = Orbit(P, t);
+    const SimulatorOptions& so = options_;
+    if (so.face_out_start_s >= 0) {
+      // Sideways out of view and back.
+      const double out = Ramp(t, so.face_out_start_s, so.face_out_start_s + 0.4) -
+                         Ramp(t, so.face_out_end_s, so.face_out_end_s + 0.4);
+      P.p.x() += 0.6 * out;
+    }
+    return P;
+  };
+  cv::Mat mirrored;
+  cv::flip(photo, mirrored, 1);
+  cv::Rect mr = o.face_region;
+  mr.x = photo.cols - o.face_region.x - o.face_region.width;
+  second_face_ = MakeFaceBillboard(mirrored, mr, o.face_region.width * m_per_px);
+  second_face_.pose = [this](double t) {
+    const SimulatorOptions& so = options_;
+    const double s = Ramp(t, so.second_face_start_s, so.second_face_start_s + 0.6 * so.duration_s);
+    const double d = 1.2 + (so.second_face_final_distance_m - 1.2) * s;
+    Pose P;
+    P.p = Eigen::Vector3d(0.28 * d, 0.02, d) + Body(t);
+    return P;
+  };
+  occluder_.bgra = cv::Mat(30, 12, CV_8UC4, cv::Scalar(70, 110, 170, 255));  // a hand
+  occluder_.metres_per_px = 0.01;
+  occluder_.anchor_px = Eigen::Vector2d(5.5, 14.5);
+  occluder_.pose = [this](double t) {
+    const SimulatorOptions& so = options_;
+    const double s = Ramp(t, so.occlusion_start_s, so.occlusion_end_s);
+    Pose P = face_.pose(t);
+    P.R = Eigen::Quaterniond::Identity();
+    P.p.z() -= 0.15;
+    P.p.x() += -0.25 + 0.5 * s;
+    return P;
+  };
+  if (o.use_real_gyro) {
+    std::vector<GyroSample> raw;
+    Status st = LoadDeepFvsGyro(o.data_dir + "/gyro/gyro_log_144425_189635.txt", &raw);
+    if (!st.ok()) return st;
+    OrientationTimelineOptions to;
+    to.buffer_duration_s = 600.0;
+    to.max_samples = 10000000;
+    to.max_extrapolation_s = 0.0;
+    real_gyro_.reset(new OrientationTimeline(to));
+    for (auto& g : raw) {
+      g.angular_velocity *= o.real_gyro_scale;
+      real_gyro_->AddSample(g);
+    }
+    if (ToSeconds(real_gyro_->newest()) < o.duration_s + o.readout_s + 0.06) {
+      return Status::Error("sim: the real gyro trace is shorter than the sequence");
+    }
+  }
+  // IMU.
+  std::mt19937_64 rng(options_.seed * 104729 + 3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const double t_end = o.duration_s + o.readout_s + 0.06;
+  const int n = static_cast<int>(t_end * o.imu_rate_hz) + 1;
+  imu_.reserve(n);
+  for (int i = 0; i < n; ++i) {
+    const double t = i / o.imu_rate_hz;
+    Eigen::Vector3d w;
+    if (real_gyro_) {
+      real_gyro_->AngularVelocity(Time(FromSeconds(t)), &w);
+    } else {
+      w = camera_.AngularVelocity(t);
+    }
+    w += o.gyro_bias + o.gyro_noise * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    const double jitter = o.imu_jitter_s * n01(rng);
+    const double clamp = 0.4 / o.imu_rate_hz;  // keep stamps ordered
+    const double stamp = t + std::max(-clamp, std::min(clamp, jitter)) - o.imu_clock_offset_s;
+    imu_.push_back({Time(FromSeconds(stamp)), w});
+  }
+  return Status::Ok();
+}
+
+Eigen::Vector3d Simulator::Body(double t) const {
+  const double w = 2.0 * M_PI * options_.body_bob_hz;
+  return Eigen::Vector3d(options_.body_sway_m * std::sin(0.5 * w * t),
+                         options_.body_bob_m * std::sin(w * t), 0.0);
+}
+
+Pose Simulator::Orbit(const Pose& P, double t) const {
+  if (!options_.pan_orbits_head || options_.camera.pan_rate == 0.0) return P;
+  const Eigen::Quaterniond R_pan(
+      Eigen::AngleAxisd(camera_.PanAngle(t), Eigen::Vector3d::UnitY()));
+  const Eigen::Vector3d pivot(0.0, 0.0, options_.head.distance_m);
+  Pose out;
+  out.R = R_pan * P.R;
+  out.p = pivot + R_pan * (P.p - pivot);
+  return out;
+}
+
+Pose Simulator::CameraPose(double t) const {
+  Pose C;
+  if (real_gyro_) {
+    real_gyro_->CameraToWorld(Time(FromSeconds(t)), &C.R);
+  } else {
+    C.R = camera_.Orientation(t);  // includes the pan
+  }
+  C.p = camera_.Position(t) + Body(t);
+  if (options_.pan_orbits_head && options_.camera.pan_rate != 0.0 && !real_gyro_) {
+    const Eigen::Quaterniond R_pan(
+        Eigen::AngleAxisd(camera_.PanAngle(t), Eigen::Vector3d::UnitY()));
+    const Eigen::Vector3d pivot(0.0, 0.0, options_.head.distance_m);
+    C.p = pivot + R_pan * (C.p - pivot);
+  }
+  return C;
+}
+
+Time Simulator::Stamp(int i) const { return Time(FromSeconds(0.05 + i / options_.fps)); }
+
+double Simulator::RowTimeS(Time stamp, double y) const {
+  return ToSeconds(timing_.RowTime(stamp, y));
+}
+
+SimTruth Simulator::Truth(int i) const {
+  SimTruth tr;
+  tr.stamp = Stamp(i);
+  const CameraIntrinsics& k = intrinsics_;
+  const int n_rows = 16;
+  for (int r = 0; r < n_rows; ++r) {
+    const double y = r * (k.height - 1.0) / (n_rows - 1);
+    tr.rotation_rows.push_back(y);
+    tr.R_r.push_back(CameraPose(RowTimeS(tr.stamp, y)).R.conjugate());
+  }
+  auto row_time = [&](double y) { return RowTimeS(tr.stamp, y); };
+  auto cam = [this](double t) { return CameraPose(t); };
+  const bool visible = ProjectRollingShutter(
+      k, row_time, cam, [&](double t) { return face_.WorldPoint(face_centre_uv_, t); },
+      &tr.head_px);
+  tr.head_in_view = visible && tr.head_px.x() >= 0 && tr.head_px.y() >= 0 &&
+                    tr.head_px.x() <= k.width - 1 && tr.head_px.y() <= k.height - 1;
+  Eigen::Vector2d a, b;
+  const double half = 0.5 * options_.face_width_px;
+  if (ProjectRollingShutter(k, row_time, cam, [&](double t) {
+        return face_.WorldPoint(face_centre_uv_ - Eigen::Vector2d(half, 0), t);
+      }, &a) &&
+      ProjectRollingShutter(k, row_time, cam, [&](double t) {
+        return face_.WorldPoint(face_centre_uv_ + Eigen::Vector2d(half, 0), t);
+      }, &b)) {
+    tr.face_scale_px = (b - a).norm();
+  }
+  const double t = ToSeconds(tr.stamp);
+  const SimulatorOptions& o = options_;
+  tr.occluded = Active(t, o.occlusion_start_s + 0.3 * (o.occlusion_end_s - o.occlusion_start_s),
+                       o.occlusion_start_s + 0.7 * (o.occlusion_end_s - o.occlusion_start_s));
+  tr.face_out = !tr.head_in_view;
+  tr.second_face = Active(t, o.second_face_start_s, -1);
+  tr.brightness_changed = Active(t, o.brightness_change_s, -1);
+  return tr;
+}
+
+Status Simulator::Render(int i, cv::Mat* bgr, SimTruth* truth) const {
+  if (i < 0 || i >= num_frames_) return Status::Error("sim: frame index out of range");
+  *truth = Truth(i);
+  const Time stamp = truth->stamp;
+  const double t = ToSeconds(stamp);
+  std::vector<const Billboard*> boards;
+  if (Active(t, options_.second_face_start_s, -1)) boards.push_back(&second_face_);
+  boards.push_back(&face_);
+  if (Active(t, options_.occlusion_start_s, options_.occlusion_end_s)) {
+    boards.push_back(&occluder_);
+  }
+  RenderScene(intrinsics_, [&](double y) { return RowTimeS(stamp, y); },
+              [this](double tt) { return CameraPose(tt); }, *background_, boards,
+              options_.band_rows, bgr);
+  if (options_.brightness_change_s >= 0) {
+    const double g = 1.0 + (options_.brightness_gain - 1.0) *
+                               Ramp(t, options_.brightness_change_s,
+                                    options_.brightness_change_s + 0.3);
+    if (g != 1.0) bgr->convertTo(*bgr, -1, g, 0.0);
+  }
+  return Status::Ok();
+}
+
+bool Simulator::BackgroundPixel(int i, const Eigen::Vector3d& d, Eigen::Vector2d* px) const {
+  const Time stamp = Stamp(i);
+  const CameraIntrinsics& k = intrinsics_;
+  double y = 0.5 * (k.height - 1);
+  Eigen::Vector2d p;
+  for (int it = 0; it < 10; ++it) {
+    const Eigen::Vector3d c = CameraPose(RowTimeS(stamp, y)).R.conjugate() * d;
+    if (c.z() <= 1e-9) return false;
+    p = Eigen::Vector2d(k.fx * c.x() / c.z() + k.cx, k.fy * c.y() / c.z() + k.cy);
+    y = std::min(std::max(p.y(), 0.0), k.height - 1.0);
+  }
+  *px = p;
+  return true;
+}
+
+}  // namespace sim
+}  // namespace steadiface
