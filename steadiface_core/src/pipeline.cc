@@ -125,6 +125,19 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   return Status::Ok();
 }
 
+Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
+  PipelineFrame f;
+  const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
+  f.stabilizer.rows = RowRotations(I, model_.intrinsics().height);
+  f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(Eigen::Vector2d::Zero());
+  Status s = warper_->Warp(image, I, Eigen::Vector2d::Zero(), f.stabilizer.rows, &f.output);
+  f.timings.mesh_ms = warper_->timings().mesh_ms;
+  f.timings.maps_ms = warper_->timings().maps_ms;
+  f.timings.remap_ms = warper_->timings().remap_ms;
+  *out = std::move(f);
+  return s;
+}
+
 Status Pipeline::UpdateStabilizerOptions(const StabilizerOptions& options) {
   Status s = stabilizer_->UpdateOptions(options);
   if (s.ok()) options_.stabilizer = options;

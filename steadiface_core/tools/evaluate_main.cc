@@ -3,7 +3,7 @@
 // report.json and per-(preset, method) trajectory CSVs for the plots.
 //
 //   steadiface_evaluate --data test/data --out out/eval
-//       [--presets walk,run] [--methods none,gyro-only,steadiface] \
+//       [--presets walk,run] [--methods none,gyro-only,steadiface]
 //       [--duration 3] [--size 640x360] [--seed 1] [--render]
 #include <cstdio>
 #include <cstring>

@@ -3,6 +3,11 @@
 #include <cmath>
 #include <sstream>
 
+#include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgproc.hpp>
+#include <sensor_msgs/image_encodings.h>
+
+#include "steadiface_core/so3.h"
 #include "steadiface_ros/time_conversion.h"
 
 namespace steadiface_ros {
@@ -86,6 +91,179 @@ geometry_msgs::Transform ToTransformMsg(const Eigen::Quaterniond& q) {
   geometry_msgs::Transform t;
   t.rotation = ToMsg(q);
   return t;
+}
+
+steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
+  using steadiface::Status;
+  namespace enc = sensor_msgs::image_encodings;
+  if (msg.width == 0 || msg.height == 0) {
+    return Status::Error("image: zero size (" + std::to_string(msg.width) + "x" +
+                         std::to_string(msg.height) + ")");
+  }
+  if (msg.width > 16384 || msg.height > 16384) {
+    return Status::Error("image: implausible size " + std::to_string(msg.width) + "x" +
+                         std::to_string(msg.height));
+  }
+  int channels = 0, depth = 0;
+  try {
+    channels = enc::numChannels(msg.encoding);
+    depth = enc::bitDepth(msg.encoding);
+  } catch (const std::exception&) {
+    return Status::Error("image: unknown encoding '" + msg.encoding + "'");
+  }
+  const uint64_t min_step = static_cast<uint64_t>(msg.width) * channels * (depth / 8);
+  if (min_step == 0 || msg.step < min_step) {
+    return Status::Error("image: step " + std::to_string(msg.step) + " is smaller than width * pixel size " +
+                         std::to_string(min_step));
+  }
+  if (static_cast<uint64_t>(msg.step) * msg.height != msg.data.size()) {
+    return Status::Error("image: data has " + std::to_string(msg.data.size()) + " bytes, step * height is " +
+                         std::to_string(static_cast<uint64_t>(msg.step) * msg.height));
+  }
+  const bool bigendian_mismatch = depth > 8 && msg.is_bigendian;
+  const std::string& e = msg.encoding;
+  if (!bigendian_mismatch && (e == enc::MONO8 || e == enc::BGR8 || e == enc::BGRA8 ||
+                              e == enc::TYPE_8UC1 || e == enc::TYPE_8UC3 || e == enc::TYPE_8UC4)) {
+    const int type = CV_MAKETYPE(CV_8U, channels);
+    // Wraps the message's memory (const_cast: we never write to it).
+    *image = cv::Mat(msg.height, msg.width, type, const_cast<uint8_t*>(msg.data.data()), msg.step);
+    return Status::Ok();
+  }
+  if (e == enc::RGB8 || e == enc::RGBA8) {
+    const cv::Mat src(msg.height, msg.width, CV_MAKETYPE(CV_8U, channels),
+                      const_cast<uint8_t*>(msg.data.data()), msg.step);
+    cv::cvtColor(src, *image, e == enc::RGB8 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGR);
+    return Status::Ok();
+  }
+  // Anything cv_bridge converts cleanly (bayer, yuv422, 16-bit, ...).
+  try {
+    cv_bridge::CvImageConstPtr cv = cv_bridge::toCvCopy(msg, channels == 1 && depth == 8 ? enc::MONO8 : enc::BGR8);
+    *image = cv->image;
+    return Status::Ok();
+  } catch (const cv_bridge::Exception& ex) {
+    return Status::Error("image: unsupported encoding '" + e + "' (" + ex.what() +
+                         "); supported: mono8, bgr8, rgb8, bgra8, rgba8 and what cv_bridge converts");
+  } catch (const cv::Exception& ex) {
+    return Status::Error("image: conversion of '" + e + "' failed: " + ex.what());
+  }
+}
+
+sensor_msgs::CameraInfo ToCameraInfo(const steadiface::CameraIntrinsics& k,
+                                     const std_msgs::Header& header) {
+  sensor_msgs::CameraInfo info;
+  info.header = header;
+  info.width = k.width;
+  info.height = k.height;
+  info.distortion_model = "plumb_bob";
+  info.D = {0.0, 0.0, 0.0, 0.0, 0.0};
+  info.K = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
+  info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+  info.P = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
+  return info;
+}
+
+steadiface::FaceLandmarks ToMsg(const steadiface::FaceInfo& f, const std_msgs::Header& header) {
+  steadiface::FaceLandmarks m;
+  m.header = header;
+  m.state = f.state == steadiface::TrackingState::kTracking
+                ? steadiface::FaceLandmarks::TRACKING
+                : f.state == steadiface::TrackingState::kLost ? steadiface::FaceLandmarks::LOST
+                                                              : steadiface::FaceLandmarks::SEARCHING;
+  m.failure = steadiface::FaceFailureName(f.failure);
+  m.valid = f.valid;
+  m.confidence = static_cast<float>(f.confidence);
+  m.box_x = static_cast<float>(f.box.x);
+  m.box_y = static_cast<float>(f.box.y);
+  m.box_width = static_cast<float>(f.box.width);
+  m.box_height = static_cast<float>(f.box.height);
+  for (const auto& p : f.landmarks_px) {
+    geometry_msgs::Point q;
+    q.x = p.x();
+    q.y = p.y();
+    m.points.push_back(q);
+  }
+  m.centre.x = f.centre_px.x();
+  m.centre.y = f.centre_px.y();
+  m.scale = static_cast<float>(f.scale_px);
+  m.has_pose = f.has_pose;
+  m.yaw = static_cast<float>(f.yaw);
+  m.pitch = static_cast<float>(f.pitch);
+  m.roll = static_cast<float>(f.roll);
+  return m;
+}
+
+steadiface::Status FromMsg(const steadiface::FaceLandmarks& m, std::vector<Eigen::Vector2d>* points,
+                           double* confidence) {
+  points->clear();
+  *confidence = std::isfinite(m.confidence) ? std::min(1.0f, std::max(0.0f, m.confidence)) : 0.0;
+  if (!m.valid) return steadiface::Status::Ok();
+  if (m.points.size() != 68) {
+    return steadiface::Status::Error("landmarks_in: need 68 points, got " +
+                                     std::to_string(m.points.size()));
+  }
+  for (const auto& p : m.points) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
+      points->clear();
+      return steadiface::Status::Error("landmarks_in: non-finite point");
+    }
+    points->emplace_back(p.x, p.y);
+  }
+  return steadiface::Status::Ok();
+}
+
+steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std_msgs::Header& header,
+                                  bool gyro_extrapolated) {
+  const steadiface::StabilizerFrame& f = pf.stabilizer;
+  steadiface::StabilizerState m;
+  m.header = header;
+  m.has_target = f.has_target;
+  m.target_h = {f.H.x(), f.H.y()};
+  m.centre_c = {f.C.x(), f.C.y()};
+  m.virtual_rotation = ToMsg(f.R_v);
+  m.real_rotation = ToMsg(f.R_r);
+  m.principal_offset = {f.t.x(), f.t.y()};
+  m.energy_fit = f.energies.fit;
+  m.energy_distortion = f.energies.distortion;
+  m.energy_follow = f.energies.follow;
+  m.energy_rotation = f.energies.rotation;
+  m.energy_translation = f.energies.translation;
+  m.energy_protrusion = f.energies.protrusion;
+  m.w_fit = f.weights.fit;
+  m.w_distortion = f.weights.distortion;
+  m.w_follow = f.weights.follow;
+  m.w_rotation_c0 = f.weights.rotation_c0;
+  m.w_rotation_c1 = f.weights.rotation_c1;
+  m.w_translation_c0 = f.weights.translation_c0;
+  m.w_translation_c1 = f.weights.translation_c1;
+  m.w_protrusion = f.weights.protrusion;
+  m.fit_factor = f.factors.fit;
+  m.smoothness_factor = f.factors.smoothness;
+  m.mean_angular_speed = f.factors.mean_angular_speed;
+  m.solver_iterations = static_cast<uint32_t>(std::max(0, f.solver.iterations));
+  m.solver_termination = f.solver.termination;
+  m.solver_time_ms = f.solver.time_ms;
+  m.solver_usable = f.solver.usable;
+  m.face_used = f.flags.face_used;
+  m.held_face = f.flags.held_face;
+  m.solver_failed = f.flags.solver_failed;
+  m.protrusion_search = f.flags.protrusion_search;
+  m.protrusion_search_s = f.flags.protrusion_search_s;
+  m.previous_warp = f.flags.previous_warp;
+  m.undefined_pixels = f.flags.undefined_pixels;
+  m.gyro_extrapolated = gyro_extrapolated;
+  m.face_ms = pf.timings.face_ms;
+  m.stabilizer_ms = pf.timings.stabilizer_ms;
+  m.warp_ms = pf.timings.mesh_ms + pf.timings.maps_ms + pf.timings.remap_ms;
+  m.total_ms = pf.timings.total_ms;
+  // Nothing non-finite leaves the node.
+  auto clean = [](double& v) {
+    if (!std::isfinite(v)) v = 0.0;
+  };
+  for (double* v : {&m.energy_fit, &m.energy_distortion, &m.energy_follow, &m.energy_rotation,
+                    &m.energy_translation, &m.energy_protrusion, &m.mean_angular_speed}) {
+    clean(*v);
+  }
+  return m;
 }
 
 }  // namespace steadiface_ros

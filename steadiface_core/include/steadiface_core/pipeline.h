@@ -86,6 +86,10 @@ class Pipeline {
                       const std::vector<Eigen::Vector2d>* external_landmarks,
                       double external_confidence, PipelineFrame* out);
 
+  /// Without gyro: the plain centre crop (identity pose), same output size
+  /// and intrinsics as stabilized frames; the trajectory is not touched.
+  Status Passthrough(const cv::Mat& image, PipelineFrame* out);
+
   /// Replaces the stabilizer's tunable options from the next frame on.
   Status UpdateStabilizerOptions(const StabilizerOptions& options);
 

@@ -3,12 +3,18 @@
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Transform.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
 
+#include "steadiface/FaceLandmarks.h"
+#include "steadiface/StabilizerState.h"
 #include "steadiface_core/camera_intrinsics.h"
+#include "steadiface_core/face/face_types.h"
 #include "steadiface_core/orientation_timeline.h"
+#include "steadiface_core/pipeline.h"
 #include "steadiface_core/status.h"
 
 namespace steadiface_ros {
@@ -31,5 +37,28 @@ geometry_msgs::Quaternion ToMsg(const Eigen::Quaterniond& q);
 
 /// A rotation-only transform.
 geometry_msgs::Transform ToTransformMsg(const Eigen::Quaterniond& q);
+
+/// Validates an image message before touching its memory (encoding, size,
+/// step, data length) and wraps or converts it to an 8-bit cv::Mat: mono8
+/// stays 1 channel, bgr8 stays 3, bgra8 4; rgb8/rgba8 and anything else
+/// cv_bridge converts cleanly become bgr8. `*image` may share the message's
+/// memory: keep the message alive while using it.
+steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image);
+
+/// Output camera_info for the stabilized image: the virtual intrinsics,
+/// no distortion, identity R, P = [K | 0].
+sensor_msgs::CameraInfo ToCameraInfo(const steadiface::CameraIntrinsics& k,
+                                     const std_msgs::Header& header);
+
+steadiface::FaceLandmarks ToMsg(const steadiface::FaceInfo& face,
+                                const std_msgs::Header& header);
+/// ~landmarks_in -> 68 pixel points (empty when !valid) and confidence.
+steadiface::Status FromMsg(const steadiface::FaceLandmarks& msg,
+                           std::vector<Eigen::Vector2d>* points,
+                           double* confidence);
+
+steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& frame,
+                                  const std_msgs::Header& header,
+                                  bool gyro_extrapolated);
 
 }  // namespace steadiface_ros

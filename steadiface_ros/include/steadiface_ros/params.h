@@ -1,0 +1,80 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <ros/node_handle.h>
+
+#include "steadiface/SteadifaceConfig.h"
+#include "steadiface_core/pipeline.h"
+#include "steadiface_core/status.h"
+
+namespace steadiface_ros {
+
+/// Where parameters come from: the ROS parameter server (node, nodelet) or
+/// a YAML file (the offline bag tool, no master). Keys are '/'-separated
+/// paths, e.g. "weights/fit".
+class ParamSource {
+ public:
+  virtual ~ParamSource() = default;
+  virtual bool Get(const std::string& key, double* v) const = 0;
+  virtual bool Get(const std::string& key, int* v) const = 0;
+  virtual bool Get(const std::string& key, bool* v) const = 0;
+  virtual bool Get(const std::string& key, std::string* v) const = 0;
+  virtual bool Get(const std::string& key, std::vector<double>* v) const = 0;
+};
+
+/// ~private namespace of a node or nodelet.
+std::unique_ptr<ParamSource> RosParams(const ros::NodeHandle& private_nh);
+/// A YAML file (same keys as config/default.yaml). Later files override
+/// earlier ones.
+steadiface::Status YamlParams(const std::vector<std::string>& paths,
+                              std::unique_ptr<ParamSource>* out);
+
+/// What to do with a frame whose last row the gyro has not covered within
+/// max_gyro_wait.
+enum class LateFramePolicy {
+  kExtrapolate,  ///< process with the gyro extrapolated (bounded by imu/max_extrapolation)
+  kDrop,         ///< drop and count it
+};
+
+/// ROS-layer options (the core's are in PipelineOptions).
+struct WrapperOptions {
+  /// Frame of the published stabilized image; empty = input frame + suffix.
+  std::string camera_frame;
+  std::string stabilized_suffix = "_stabilized";
+  std::string world_frame = "steadiface_world";
+  bool publish_world_tf = true;
+  /// Look up the IMU -> camera rotation in TF when the IMU frame differs.
+  bool imu_extrinsics_from_tf = true;
+  /// Max wait for gyro coverage of a frame's last row [s].
+  double max_gyro_wait_s = 0.1;
+  LateFramePolicy late_frame_policy = LateFramePolicy::kExtrapolate;
+  /// Frames waiting for gyro [count]; older ones are dropped when full.
+  int frame_queue_size = 10;
+  /// No IMU message for this long -> ERROR diagnostic, frames pass through
+  /// unstabilized [s].
+  double imu_timeout_s = 1.0;
+  /// IMU gap that raises a WARN [s].
+  double imu_gap_warn_s = 0.05;
+  /// Expected rates for the FrequencyStatus diagnostics [Hz] (0 = any).
+  double expected_image_rate = 0.0;
+  double expected_imu_rate = 0.0;
+  /// Publish frames unstabilized (centre crop) when no gyro is available.
+  bool passthrough_without_imu = true;
+};
+
+/// Loads every option, validating each; errors name the key and its valid
+/// range.
+steadiface::Status LoadOptions(const ParamSource& params,
+                               steadiface::PipelineOptions* pipeline,
+                               WrapperOptions* wrapper);
+
+/// dynamic_reconfigure <-> stabilizer options.
+void ApplyConfig(const steadiface::SteadifaceConfig& config,
+                 steadiface::StabilizerOptions* options);
+steadiface::SteadifaceConfig ConfigFromOptions(
+    const steadiface::StabilizerOptions& options);
+
+}  // namespace steadiface_ros

@@ -1,0 +1,154 @@
+#pragma once
+
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <ros/time.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
+
+#include "steadiface/FaceLandmarks.h"
+#include "steadiface/StabilizerState.h"
+#include "steadiface_core/pipeline.h"
+#include "steadiface_ros/params.h"
+
+namespace steadiface_ros {
+
+/// Where the wrapper's results go: ROS publishers (nodelet, node) or an
+/// output bag (steadiface_bag). Same calls in the same order either way.
+class OutputSink {
+ public:
+  virtual ~OutputSink() = default;
+  virtual void PublishImage(const sensor_msgs::ImagePtr& image,
+                            const sensor_msgs::CameraInfoPtr& info) = 0;
+  virtual void PublishLandmarks(const steadiface::FaceLandmarks& msg) = 0;
+  virtual void PublishState(const steadiface::StabilizerState& msg) = 0;
+  virtual void PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) = 0;
+  /// Debug images are rendered only when this returns true.
+  virtual bool WantsDebugImage() const = 0;
+  virtual void PublishDebugImage(const sensor_msgs::ImagePtr& image) = 0;
+  /// Throttled log lines (the nodelet maps them to NODELET_*_THROTTLE).
+  virtual void Warn(const std::string& key, const std::string& text) = 0;
+  virtual void Error(const std::string& key, const std::string& text) = 0;
+};
+
+/// Counters behind the diagnostics, all since start.
+struct WrapperCounters {
+  uint64_t images_in = 0, imu_in = 0, frames_out = 0;
+  uint64_t dropped_bad_image = 0;       ///< encoding, size, step, size vs camera_info
+  uint64_t dropped_bad_info = 0;        ///< uncalibrated / invalid camera_info
+  uint64_t dropped_no_gyro = 0;         ///< gyro never covered within the wait (policy drop)
+  uint64_t dropped_queue_full = 0;      ///< burst beyond frame_queue_size
+  uint64_t dropped_old_stamp = 0;       ///< not after the previous frame
+  uint64_t dropped_pipeline_error = 0;  ///< stabilizer/warp refused the frame
+  uint64_t extrapolated = 0;            ///< processed with extrapolated gyro
+  uint64_t passthrough = 0;             ///< published unstabilized (no IMU)
+  uint64_t imu_rejected = 0;            ///< non-finite, implausible, duplicate, out of order
+  uint64_t imu_gaps = 0;                ///< gaps longer than imu_gap_warn
+  uint64_t time_jumps = 0;              ///< time went backwards: full reset
+  uint64_t rebuilds = 0;                ///< camera geometry changed: maps rebuilt
+  uint64_t landmarks_bad = 0;           ///< ~landmarks_in messages rejected
+  uint64_t tf_skipped = 0;              ///< TF not newer than the last one
+};
+
+/// A snapshot for the diagnostics tasks.
+struct WrapperStatus {
+  WrapperCounters counters;
+  bool pipeline_ready = false;
+  bool imu_ever = false;
+  double seconds_since_imu = 1e9;        ///< data time since the newest IMU sample
+  double gyro_latency_s = 0.0;           ///< newest gyro minus last row of the last frame
+  steadiface::TimelineStats timeline;
+  steadiface::StabilizerStats stabilizer;
+  steadiface::TrackingState face_state = steadiface::TrackingState::kSearching;
+  std::string face_failure;
+  double face_confidence = 0.0;
+  std::string last_solver_termination;
+  double last_solver_ms = 0.0;
+  int last_solver_iterations = 0;
+  std::string last_error;
+};
+
+/// The one object behind the nodelet, the node and the offline bag tool: it
+/// converts messages, buffers IMU continuously, queues frames until the
+/// gyro covers their last row (bounded wait), runs the core Pipeline and
+/// hands the results to an OutputSink.
+///
+/// Threading: OnImu / OnImage / OnLandmarks / OnTimer / Flush must be
+/// serialized by the owner (the nodelet runs them on one callback queue).
+/// RequestStabilizerOptions() may be called from any thread (the
+/// dynamic_reconfigure server's): it only stores the request under its own
+/// mutex; the next frame applies it.
+class StabilizerWrapper {
+ public:
+  /// `extrinsic_lookup(imu_frame, camera_frame, &R_cam_imu)` (optional) is
+  /// asked for the IMU -> camera rotation when the frames differ.
+  using ExtrinsicLookup =
+      std::function<bool(const std::string&, const std::string&, Eigen::Quaterniond*)>;
+
+  StabilizerWrapper(const steadiface::PipelineOptions& pipeline,
+                    const WrapperOptions& options, OutputSink* sink,
+                    ExtrinsicLookup extrinsic_lookup = {});
+
+  void OnImu(const sensor_msgs::Imu& msg);
+  void OnImage(const sensor_msgs::ImageConstPtr& image,
+               const sensor_msgs::CameraInfoConstPtr& info, const ros::Time& now);
+  void OnLandmarks(const steadiface::FaceLandmarks& msg);
+  /// Processes queued frames whose wait ran out; `now` is ROS time live,
+  /// the current message time offline.
+  void OnTimer(const ros::Time& now);
+  /// End of input (bag): processes everything still queued.
+  void Flush();
+
+  void RequestStabilizerOptions(const steadiface::StabilizerOptions& options);
+
+  WrapperStatus Status() const;
+  const steadiface::PipelineOptions& pipeline_options() const { return options_; }
+
+ private:
+  struct Pending {
+    sensor_msgs::ImageConstPtr image;
+    sensor_msgs::CameraInfoConstPtr info;
+    ros::Time received;
+  };
+  void Drain(const ros::Time& now, bool flush);
+  void Process(const Pending& p, bool allow_extrapolation);
+  bool EnsurePipeline(const sensor_msgs::CameraInfo& info, const std::string& frame_id);
+  void ResetAll(const char* why);
+  void ApplyPendingOptions();
+  void Publish(const Pending& p, const steadiface::PipelineFrame& frame,
+               const cv::Mat& input, bool extrapolated, bool passthrough);
+
+  steadiface::PipelineOptions options_;
+  const WrapperOptions wrapper_options_;
+  OutputSink* sink_;
+  ExtrinsicLookup extrinsic_lookup_;
+
+  std::unique_ptr<steadiface::Pipeline> pipeline_;
+  sensor_msgs::CameraInfo pipeline_info_;
+  std::string imu_frame_;
+  bool extrinsic_resolved_ = false;
+  std::deque<steadiface::GyroSample> recent_gyro_;  // bounded, for rebuilds
+  std::deque<Pending> queue_;                       // bounded by frame_queue_size
+  std::vector<Eigen::Vector2d> external_landmarks_;
+  double external_confidence_ = 0.0;
+  ros::Time last_external_stamp_;
+  ros::Time last_frame_stamp_;
+  ros::Time last_tf_stamp_;
+  ros::Time last_imu_stamp_;
+  bool have_last_imu_ = false;
+  WrapperCounters counters_;
+  WrapperStatus status_;
+
+  std::mutex options_mutex_;
+  bool options_pending_ = false;
+  steadiface::StabilizerOptions requested_options_;
+};
+
+}  // namespace steadiface_ros

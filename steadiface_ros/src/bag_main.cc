@@ -1,0 +1,454 @@
+// steadiface_bag: processes a bag offline, as fast as the machine allows,
+// through the same StabilizerWrapper as the nodelet (no ROS master).
+//
+//   rosrun steadiface steadiface_bag --in input.bag [--out output.bag]
+//     [--params a.yaml [--params b.yaml]] [--image camera/image_raw]
+//     [--info camera/camera_info] [--imu imu] [--landmarks TOPIC]
+//     [--video side_by_side.mp4] [--debug-overlay] [--report report.json]
+//     [--trajectory traj.csv] [--gyro-only]
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <ros/package.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "steadiface_core/so3.h"
+#include "steadiface_ros/msg_conversion.h"
+#include "steadiface_ros/params.h"
+#include "steadiface_ros/stabilizer_wrapper.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Args {
+  std::string in, out, video, report, trajectory;
+  std::vector<std::string> params;
+  std::string image_topic = "camera/image_raw", info_topic = "camera/camera_info",
+              imu_topic = "imu", landmarks_topic;
+  bool debug_overlay = false, gyro_only = false, quiet = false;
+};
+
+int Usage() {
+  std::cerr
+      << "usage: steadiface_bag --in IN.bag [--out OUT.bag] [--params P.yaml]...\n"
+         "  [--image TOPIC] [--info TOPIC] [--imu TOPIC] [--landmarks TOPIC]\n"
+         "  [--video OUT.mp4] [--debug-overlay] [--report OUT.json]\n"
+         "  [--trajectory OUT.csv] [--gyro-only] [--quiet]\n";
+  return 2;
+}
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
+}
+
+// High-pass (> cutoff) RMS of a series, linear trend removed (DFT).
+double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps, double cutoff) {
+  const int n = static_cast<int>(x.size());
+  if (n < 8) return 0.0;
+  double total = 0.0;
+  for (int axis = 0; axis < 2; ++axis) {
+    double st = 0, sx = 0, stt = 0, stx = 0;
+    for (int i = 0; i < n; ++i) {
+      st += i;
+      sx += x[i][axis];
+      stt += double(i) * i;
+      stx += i * x[i][axis];
+    }
+    const double b = (n * stx - st * sx) / (n * stt - st * st), a = (sx - b * st) / n;
+    cv::Mat in(1, n, CV_64F), spec, back;
+    for (int i = 0; i < n; ++i) in.at<double>(0, i) = x[i][axis] - (a + b * i);
+    cv::dft(in, spec, cv::DFT_COMPLEX_OUTPUT);
+    for (int k = 0; k < n; ++k) {
+      if (std::min(k, n - k) * fps / n < cutoff) spec.at<cv::Vec2d>(0, k) = cv::Vec2d(0, 0);
+    }
+    cv::dft(spec, back, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+    for (int i = 0; i < n; ++i) total += back.at<double>(0, i) * back.at<double>(0, i);
+  }
+  return std::sqrt(total / n);
+}
+
+// Collects everything the wrapper produces: to the output bag, the video
+// and the report.
+class BagSink : public steadiface_ros::OutputSink {
+ public:
+  rosbag::Bag* out = nullptr;
+  bool debug = false;
+  // Same names as the node publishes in the camera's namespace.
+  std::string ns = "/camera";
+  std::string T(const std::string& leaf) const { return ns + "/" + leaf; }
+  sensor_msgs::ImagePtr last_image, last_debug;
+  std::vector<steadiface::StabilizerState> states;
+  std::vector<steadiface::FaceLandmarks> landmarks;
+  std::vector<geometry_msgs::TransformStamped> tfs;
+  std::map<std::string, int> warnings;
+
+  void PublishImage(const sensor_msgs::ImagePtr& image, const sensor_msgs::CameraInfoPtr& info) override {
+    last_image = image;
+    if (out) {
+      out->write(T("image_stabilized/image_raw"), image->header.stamp, *image);
+      out->write(T("image_stabilized/camera_info"), info->header.stamp, *info);
+    }
+  }
+  void PublishLandmarks(const steadiface::FaceLandmarks& m) override {
+    landmarks.push_back(m);
+    if (out) out->write(T("face_landmarks"), m.header.stamp, m);
+  }
+  void PublishState(const steadiface::StabilizerState& m) override {
+    states.push_back(m);
+    if (out) out->write(T("state"), m.header.stamp, m);
+  }
+  void PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) override {
+    tfs.insert(tfs.end(), tf.begin(), tf.end());
+    if (out && !tf.empty()) {
+      tf2_msgs::TFMessage m;
+      m.transforms = tf;
+      out->write("/tf", tf.front().header.stamp, m);
+    }
+  }
+  bool WantsDebugImage() const override { return debug; }
+  void PublishDebugImage(const sensor_msgs::ImagePtr& image) override {
+    last_debug = image;
+    if (out) out->write(T("debug_image"), image->header.stamp, *image);
+  }
+  void Warn(const std::string& key, const std::string& text) override {
+    if (warnings[key]++ == 0) std::cerr << "warning: " << text << "\n";
+  }
+  void Error(const std::string& key, const std::string& text) override {
+    if (warnings[key]++ == 0) std::cerr << "error: " << text << "\n";
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string s = argv[i];
+    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+    if (s == "--in") a.in = next();
+    else if (s == "--out") a.out = next();
+    else if (s == "--params") a.params.push_back(next());
+    else if (s == "--image") a.image_topic = next();
+    else if (s == "--info") a.info_topic = next();
+    else if (s == "--imu") a.imu_topic = next();
+    else if (s == "--landmarks") a.landmarks_topic = next();
+    else if (s == "--video") a.video = next();
+    else if (s == "--debug-overlay") a.debug_overlay = true;
+    else if (s == "--report") a.report = next();
+    else if (s == "--trajectory") a.trajectory = next();
+    else if (s == "--gyro-only") a.gyro_only = true;
+    else if (s == "--quiet") a.quiet = true;
+    else return Usage();
+  }
+  if (a.in.empty()) return Usage();
+  // Parameters: the package defaults, then the user's files.
+  std::vector<std::string> param_files;
+  const std::string pkg = ros::package::getPath("steadiface");
+  if (!pkg.empty()) param_files.push_back(pkg + "/config/default.yaml");
+  param_files.insert(param_files.end(), a.params.begin(), a.params.end());
+  std::unique_ptr<steadiface_ros::ParamSource> params;
+  steadiface::Status st = steadiface_ros::YamlParams(param_files, &params);
+  steadiface::PipelineOptions po;
+  steadiface_ros::WrapperOptions wo;
+  if (st.ok()) st = steadiface_ros::LoadOptions(*params, &po, &wo);
+  if (!st.ok()) {
+    std::cerr << "steadiface_bag: " << st.message() << "\n";
+    return 1;
+  }
+  if (a.gyro_only) {
+    po.stabilizer.gyro_only = true;
+    po.landmark_source = steadiface::LandmarkSource::kNone;
+  }
+  if (!a.landmarks_topic.empty()) po.landmark_source = steadiface::LandmarkSource::kExternal;
+
+  rosbag::Bag in;
+  try {
+    in.open(a.in, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& e) {
+    std::cerr << "steadiface_bag: cannot open '" << a.in << "': " << e.what() << "\n";
+    return 1;
+  }
+  // Topics and types.
+  auto norm = [](std::string t) { return t.empty() || t[0] == '/' ? t : "/" + t; };
+  std::map<std::string, std::string> types;
+  {
+    rosbag::View all(in);
+    for (const rosbag::ConnectionInfo* c : all.getConnections()) types[norm(c->topic)] = c->datatype;
+  }
+  const std::vector<std::pair<std::string, std::string>> want = {
+      {a.image_topic, "sensor_msgs/Image"},
+      {a.info_topic, "sensor_msgs/CameraInfo"},
+      {a.imu_topic, "sensor_msgs/Imu"}};
+  for (const auto& w : want) {
+    auto it = types.find(norm(w.first));
+    if (it == types.end()) {
+      std::cerr << "steadiface_bag: topic '" << norm(w.first) << "' (" << w.second
+                << ") is not in " << a.in << "; topics there:";
+      for (const auto& t : types) std::cerr << " " << t.first << " [" << t.second << "]";
+      std::cerr << "\n";
+      if (w.second != "sensor_msgs/Imu") return 1;
+      std::cerr << "steadiface_bag: continuing without IMU: frames pass through unstabilized\n";
+    } else if (it->second != w.second) {
+      std::cerr << "steadiface_bag: topic '" << norm(w.first) << "' has type " << it->second
+                << ", expected " << w.second << "\n";
+      return 1;
+    }
+  }
+
+  BagSink sink;
+  sink.debug = a.debug_overlay && !a.video.empty();
+  {
+    const std::string img = norm(a.image_topic);
+    const size_t slash = img.rfind('/');
+    sink.ns = slash == 0 || slash == std::string::npos ? "" : img.substr(0, slash);
+  }
+  rosbag::Bag out;
+  const std::string out_tmp = a.out + ".part";
+  if (!a.out.empty()) {
+    try {
+      out.open(out_tmp, rosbag::bagmode::Write);
+    } catch (const rosbag::BagException& e) {
+      std::cerr << "steadiface_bag: cannot write '" << out_tmp << "': " << e.what() << "\n";
+      return 1;
+    }
+    sink.out = &out;
+  }
+  steadiface_ros::StabilizerWrapper wrapper(po, wo, &sink);
+
+  // Bags store topics as recorded, with or without the leading '/'.
+  auto both = [&](const std::string& t) {
+    std::vector<std::string> v = {norm(t)};
+    if (norm(t).size() > 1) v.push_back(norm(t).substr(1));
+    return v;
+  };
+  std::vector<std::string> topics;
+  for (const std::string& t : {a.image_topic, a.info_topic, a.imu_topic, a.landmarks_topic}) {
+    if (t.empty()) continue;
+    for (const auto& v : both(t)) topics.push_back(v);
+  }
+  rosbag::View view(in, rosbag::TopicQuery(topics));
+  const size_t total_images = rosbag::View(in, rosbag::TopicQuery(both(a.image_topic))).size();
+  std::map<ros::Time, sensor_msgs::CameraInfoConstPtr> infos;
+  std::deque<sensor_msgs::ImageConstPtr> waiting;  // images whose info has not arrived
+  cv::VideoWriter video;
+  const std::string video_tmp = a.video.empty() ? "" : a.video + ".part.mp4";
+  std::map<ros::Time, cv::Mat> inputs;  // for the side-by-side video, bounded
+  const bool tty = isatty(STDERR_FILENO) && !a.quiet;
+  const auto start = Clock::now();
+  size_t images_seen = 0;
+  size_t state_written = 0;
+  std::vector<Eigen::Vector2d> centre_in, centre_out;
+  auto write_video = [&]() {
+    // Pair every new stabilized output with its input frame.
+    if (a.video.empty() || !sink.last_image) return;
+    const ros::Time t = sink.last_image->header.stamp;
+    auto it = inputs.find(t);
+    if (it == inputs.end()) return;
+    cv::Mat left = it->second, right;
+    if (sink.debug && sink.last_debug && sink.last_debug->header.stamp == t) {
+      left = cv_bridge::toCvCopy(sink.last_debug, "bgr8")->image;
+    }
+    right = cv_bridge::toCvCopy(sink.last_image, "bgr8")->image;
+    if (left.channels() == 1) cv::cvtColor(left, left, cv::COLOR_GRAY2BGR);
+    cv::resize(right, right, left.size());
+    cv::Mat both;
+    cv::hconcat(left, right, both);
+    if (!video.isOpened()) {
+      const double fps = 30.0;
+      video.open(video_tmp, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps, both.size());
+      if (!video.isOpened()) {
+        std::cerr << "steadiface_bag: cannot write video '" << video_tmp << "'\n";
+        a.video.clear();
+        return;
+      }
+    }
+    video.write(both);
+    inputs.erase(inputs.begin(), std::next(it));
+    sink.last_image.reset();
+  };
+  for (const rosbag::MessageInstance& m : view) {
+    const std::string topic = norm(m.getTopic());
+    if (topic == norm(a.imu_topic)) {
+      if (auto imu = m.instantiate<sensor_msgs::Imu>()) wrapper.OnImu(*imu);
+    } else if (topic == norm(a.info_topic)) {
+      if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+        infos[info->header.stamp] = info;
+        while (infos.size() > 64) infos.erase(infos.begin());
+      }
+    } else if (topic == norm(a.landmarks_topic)) {
+      if (auto lm = m.instantiate<steadiface::FaceLandmarks>()) wrapper.OnLandmarks(*lm);
+    } else if (topic == norm(a.image_topic)) {
+      if (auto img = m.instantiate<sensor_msgs::Image>()) {
+        waiting.push_back(img);
+        ++images_seen;
+      }
+    }
+    // Pair images with the camera_info of the same stamp (either order).
+    while (!waiting.empty()) {
+      auto it = infos.find(waiting.front()->header.stamp);
+      if (it == infos.end()) {
+        if (waiting.size() > 8) {  // no info for this image: use the latest one
+          if (infos.empty()) {
+            waiting.pop_front();
+            continue;
+          }
+          it = std::prev(infos.end());
+        } else {
+          break;
+        }
+      }
+      const sensor_msgs::ImageConstPtr img = waiting.front();
+      waiting.pop_front();
+      if (!a.video.empty()) {
+        cv::Mat mat;
+        if (steadiface_ros::ToCvImage(*img, &mat).ok()) inputs[img->header.stamp] = mat.clone();
+        while (inputs.size() > 32) inputs.erase(inputs.begin());
+      }
+      wrapper.OnImage(img, it->second, m.getTime());
+    }
+    wrapper.OnTimer(m.getTime());
+    write_video();
+    const size_t done = sink.states.size();
+    if (done != state_written && (tty || done % 100 == 0)) {
+      state_written = done;
+      const double el = std::chrono::duration<double>(Clock::now() - start).count();
+      const double fps = done / std::max(el, 1e-9);
+      const double eta = total_images > done ? (total_images - done) / std::max(fps, 1e-9) : 0.0;
+      if (tty) {
+        fprintf(stderr, "\r[%-30s] %zu/%zu frames  %.1f fps  ETA %.0f s ",
+                std::string(30 * done / std::max<size_t>(1, total_images), '#').c_str(), done,
+                total_images, fps, eta);
+      } else if (!a.quiet) {
+        fprintf(stderr, "steadiface_bag: %zu/%zu frames, %.1f fps, ETA %.0f s\n", done,
+                total_images, fps, eta);
+      }
+    }
+  }
+  wrapper.Flush();
+  write_video();
+  if (tty) fprintf(stderr, "\n");
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  in.close();
+  if (!a.out.empty()) {
+    out.close();
+    if (std::rename(out_tmp.c_str(), a.out.c_str()) != 0) {
+      std::cerr << "steadiface_bag: cannot rename " << out_tmp << "\n";
+      return 1;
+    }
+  }
+  if (video.isOpened()) {
+    video.release();
+    std::rename(video_tmp.c_str(), a.video.c_str());
+  }
+
+  // Report: what can be measured without ground truth.
+  const steadiface_ros::WrapperStatus ws = wrapper.Status();
+  std::vector<double> face_ms, stab_ms, warp_ms, total_ms, solver_ms, iters;
+  std::vector<Eigen::Vector2d> c_in, c_out, shake;
+  for (size_t i = 0; i < sink.states.size(); ++i) {
+    const auto& s = sink.states[i];
+    face_ms.push_back(s.face_ms);
+    stab_ms.push_back(s.stabilizer_ms);
+    warp_ms.push_back(s.warp_ms);
+    total_ms.push_back(s.total_ms);
+    solver_ms.push_back(s.solver_time_ms);
+    iters.push_back(s.solver_iterations);
+    // Residual camera shake: virtual rotation vector (what the viewer sees
+    // of the camera's rotation).
+    Eigen::Quaterniond q;
+    steadiface_ros::ToEigen(s.virtual_rotation, &q);
+    const Eigen::Vector3d v = steadiface::LogSO3(q);
+    Eigen::Quaterniond r;
+    steadiface_ros::ToEigen(s.real_rotation, &r);
+    const Eigen::Vector3d rv = steadiface::LogSO3(r);
+    shake.emplace_back(v.x(), v.y());
+    if (s.has_target) {
+      c_in.emplace_back(s.centre_c[0], s.centre_c[1]);
+      c_out.emplace_back(s.target_h[0], s.target_h[1]);
+    }
+    (void)rv;
+  }
+  double fps_data = 30.0;
+  if (sink.states.size() > 2) {
+    fps_data = (sink.states.size() - 1) /
+               std::max(1e-9, (sink.states.back().header.stamp - sink.states.front().header.stamp).toSec());
+  }
+  // Landmark-centre jitter: C as the input shows it (real frame, normalized
+  // x width = px) vs the target H the output holds it at.
+  const double W = ws.pipeline_ready ? 1.0 : 1.0;
+  (void)W;
+  std::ostringstream rep;
+  rep.precision(6);
+  rep << "{\n  \"input\": \"" << a.in << "\",\n  \"frames_in\": " << ws.counters.images_in
+      << ",\n  \"frames_out\": " << ws.counters.frames_out
+      << ",\n  \"wall_time_s\": " << elapsed
+      << ",\n  \"throughput_fps\": " << ws.counters.frames_out / std::max(elapsed, 1e-9)
+      << ",\n  \"landmark_centre_jitter_in_norm\": " << HighPassRms(c_in, fps_data, 0.5)
+      << ",\n  \"target_jitter_out_norm\": " << HighPassRms(c_out, fps_data, 0.5)
+      << ",\n  \"residual_rotation_jitter_rad\": " << HighPassRms(shake, fps_data, 0.5)
+      << ",\n  \"crop_ratio\": " << po.warp.output.crop_ratio
+      << ",\n  \"dropped\": {\"bad_image\": " << ws.counters.dropped_bad_image
+      << ", \"bad_info\": " << ws.counters.dropped_bad_info
+      << ", \"no_gyro\": " << ws.counters.dropped_no_gyro
+      << ", \"queue_full\": " << ws.counters.dropped_queue_full
+      << ", \"old_stamp\": " << ws.counters.dropped_old_stamp
+      << ", \"refused\": " << ws.counters.dropped_pipeline_error << "}"
+      << ",\n  \"passthrough_no_imu\": " << ws.counters.passthrough
+      << ",\n  \"extrapolated\": " << ws.counters.extrapolated
+      << ",\n  \"protrusion_searches\": " << ws.stabilizer.protrusion_searches
+      << ",\n  \"previous_warp_fallbacks\": " << ws.stabilizer.previous_warp_fallbacks
+      << ",\n  \"undefined_frames\": " << ws.stabilizer.undefined_frames
+      << ",\n  \"solver_failures\": " << ws.stabilizer.solver_failures
+      << ",\n  \"frames_with_face\": " << ws.stabilizer.frames_with_face
+      << ",\n  \"timings_ms\": {"
+      << "\"face\": [" << Percentile(face_ms, 0.5) << ", " << Percentile(face_ms, 0.99) << "], "
+      << "\"stabilizer\": [" << Percentile(stab_ms, 0.5) << ", " << Percentile(stab_ms, 0.99) << "], "
+      << "\"solver\": [" << Percentile(solver_ms, 0.5) << ", " << Percentile(solver_ms, 0.99) << "], "
+      << "\"warp\": [" << Percentile(warp_ms, 0.5) << ", " << Percentile(warp_ms, 0.99) << "], "
+      << "\"total\": [" << Percentile(total_ms, 0.5) << ", " << Percentile(total_ms, 0.99) << "]}"
+      << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5) << "\n}\n";
+  if (!a.report.empty()) {
+    std::ofstream f(a.report + ".part");
+    f << rep.str();
+    f.close();
+    std::rename((a.report + ".part").c_str(), a.report.c_str());
+  }
+  if (!a.trajectory.empty()) {
+    std::ofstream f(a.trajectory);
+    f.precision(12);
+    f << "stamp,qx,qy,qz,qw,tx,ty,rqx,rqy,rqz,rqw,has_target,hx,hy,cx,cy,w_fit\n";
+    for (const auto& s : sink.states) {
+      f << s.header.stamp.toSec() << "," << s.virtual_rotation.x << "," << s.virtual_rotation.y
+        << "," << s.virtual_rotation.z << "," << s.virtual_rotation.w << ","
+        << s.principal_offset[0] << "," << s.principal_offset[1] << "," << s.real_rotation.x
+        << "," << s.real_rotation.y << "," << s.real_rotation.z << "," << s.real_rotation.w
+        << "," << s.has_target << "," << s.target_h[0] << "," << s.target_h[1] << ","
+        << s.centre_c[0] << "," << s.centre_c[1] << "," << s.w_fit << "\n";
+    }
+  }
+  if (!a.quiet) {
+    std::cerr << "steadiface_bag: " << ws.counters.frames_out << " frames in " << elapsed
+              << " s (" << ws.counters.frames_out / std::max(elapsed, 1e-9) << " fps)"
+              << (a.out.empty() ? "" : ", wrote " + a.out)
+              << (a.video.empty() ? "" : ", " + a.video)
+              << (a.report.empty() ? "" : ", " + a.report) << "\n";
+  }
+  return ws.counters.frames_out > 0 ? 0 : 1;
+}

@@ -1,0 +1,342 @@
+#include "steadiface_ros/params.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+namespace steadiface_ros {
+namespace {
+
+using steadiface::Status;
+
+class RosParamSource : public ParamSource {
+ public:
+  explicit RosParamSource(const ros::NodeHandle& nh) : nh_(nh) {}
+  bool Get(const std::string& k, double* v) const override { return nh_.getParam(k, *v); }
+  bool Get(const std::string& k, int* v) const override { return nh_.getParam(k, *v); }
+  bool Get(const std::string& k, bool* v) const override { return nh_.getParam(k, *v); }
+  bool Get(const std::string& k, std::string* v) const override { return nh_.getParam(k, *v); }
+  bool Get(const std::string& k, std::vector<double>* v) const override {
+    return nh_.getParam(k, *v);
+  }
+
+ private:
+  ros::NodeHandle nh_;
+};
+
+class YamlParamSource : public ParamSource {
+ public:
+  explicit YamlParamSource(std::vector<YAML::Node> docs) : docs_(std::move(docs)) {}
+
+  template <typename T>
+  bool GetT(const std::string& key, T* v) const {
+    // Later documents override earlier ones.
+    for (auto it = docs_.rbegin(); it != docs_.rend(); ++it) {
+      YAML::Node n = Lookup(*it, key);
+      if (!n) continue;
+      try {
+        *v = n.as<T>();
+        return true;
+      } catch (const YAML::Exception&) {
+        return false;
+      }
+    }
+    return false;
+  }
+  bool Get(const std::string& k, double* v) const override { return GetT(k, v); }
+  bool Get(const std::string& k, int* v) const override { return GetT(k, v); }
+  bool Get(const std::string& k, bool* v) const override { return GetT(k, v); }
+  bool Get(const std::string& k, std::string* v) const override { return GetT(k, v); }
+  bool Get(const std::string& k, std::vector<double>* v) const override { return GetT(k, v); }
+
+ private:
+  static YAML::Node Lookup(const YAML::Node& root, const std::string& key) {
+    YAML::Node n = YAML::Clone(root);
+    std::stringstream ss(key);
+    std::string part;
+    while (std::getline(ss, part, '/')) {
+      if (!n.IsMap() || !n[part]) return YAML::Node();
+      n = n[part];
+    }
+    return n;
+  }
+  std::vector<YAML::Node> docs_;
+};
+
+// Reads `key` if present; checks [lo, hi]. Records the first error.
+class Reader {
+ public:
+  explicit Reader(const ParamSource& p) : p_(p) {}
+  void Num(const std::string& key, double* v, double lo, double hi) {
+    double x = *v;
+    if (!p_.Get(key, &x)) {
+      int i;
+      if (p_.Get(key, &i)) x = i;
+    }
+    if (!std::isfinite(x) || x < lo || x > hi) {
+      Fail(key, x, lo, hi);
+      return;
+    }
+    *v = x;
+  }
+  void Int(const std::string& key, int* v, int lo, int hi) {
+    int x = *v;
+    p_.Get(key, &x);
+    if (x < lo || x > hi) {
+      Fail(key, x, lo, hi);
+      return;
+    }
+    *v = x;
+  }
+  void Bool(const std::string& key, bool* v) { p_.Get(key, v); }
+  void Str(const std::string& key, std::string* v) { p_.Get(key, v); }
+  void Vec(const std::string& key, std::vector<double>* v) { p_.Get(key, v); }
+  void Error(const std::string& msg) {
+    if (error_.empty()) error_ = msg;
+  }
+  Status status() const { return error_.empty() ? Status::Ok() : Status::Error(error_); }
+
+ private:
+  void Fail(const std::string& key, double x, double lo, double hi) {
+    std::ostringstream e;
+    e << "parameter '" << key << "' = " << x << " is out of range [" << lo << ", " << hi
+      << "]";
+    Error(e.str());
+  }
+  const ParamSource& p_;
+  std::string error_;
+};
+
+}  // namespace
+
+std::unique_ptr<ParamSource> RosParams(const ros::NodeHandle& nh) {
+  return std::unique_ptr<ParamSource>(new RosParamSource(nh));
+}
+
+Status YamlParams(const std::vector<std::string>& paths, std::unique_ptr<ParamSource>* out) {
+  std::vector<YAML::Node> docs;
+  for (const auto& p : paths) {
+    try {
+      docs.push_back(YAML::LoadFile(p));
+    } catch (const YAML::Exception& e) {
+      return Status::Error("cannot read parameters '" + p + "': " + e.what());
+    }
+  }
+  out->reset(new YamlParamSource(std::move(docs)));
+  return Status::Ok();
+}
+
+Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
+                   WrapperOptions* wo) {
+  using namespace steadiface;  // NOLINT (source file, not a header)
+  Reader r(params);
+  // ROS layer.
+  r.Str("camera_frame", &wo->camera_frame);
+  r.Str("stabilized_suffix", &wo->stabilized_suffix);
+  r.Str("world_frame", &wo->world_frame);
+  r.Bool("publish_world_tf", &wo->publish_world_tf);
+  r.Bool("imu_extrinsics_from_tf", &wo->imu_extrinsics_from_tf);
+  r.Num("max_gyro_wait", &wo->max_gyro_wait_s, 0.0, 5.0);
+  std::string policy = wo->late_frame_policy == LateFramePolicy::kDrop ? "drop" : "extrapolate";
+  r.Str("late_frame_policy", &policy);
+  if (policy == "drop") {
+    wo->late_frame_policy = LateFramePolicy::kDrop;
+  } else if (policy == "extrapolate") {
+    wo->late_frame_policy = LateFramePolicy::kExtrapolate;
+  } else {
+    r.Error("parameter 'late_frame_policy' must be 'extrapolate' or 'drop', got '" + policy + "'");
+  }
+  r.Int("frame_queue_size", &wo->frame_queue_size, 1, 1000);
+  r.Num("imu_timeout", &wo->imu_timeout_s, 0.01, 60.0);
+  r.Num("imu_gap_warn", &wo->imu_gap_warn_s, 0.001, 10.0);
+  r.Num("expected_image_rate", &wo->expected_image_rate, 0.0, 1000.0);
+  r.Num("expected_imu_rate", &wo->expected_imu_rate, 0.0, 100000.0);
+  r.Bool("passthrough_without_imu", &wo->passthrough_without_imu);
+  std::string source = po->landmark_source == LandmarkSource::kExternal
+                           ? "topic"
+                           : po->landmark_source == LandmarkSource::kNone ? "none" : "dlib";
+  r.Str("landmark_source", &source);
+  if (source == "dlib") {
+    po->landmark_source = LandmarkSource::kDlib;
+  } else if (source == "topic") {
+    po->landmark_source = LandmarkSource::kExternal;
+  } else if (source == "none") {
+    po->landmark_source = LandmarkSource::kNone;
+  } else {
+    r.Error("parameter 'landmark_source' must be 'dlib', 'topic' or 'none', got '" + source + "'");
+  }
+  // Camera.
+  r.Num("camera/readout_time", &po->shutter.readout_time_s, 0.0, 0.2);
+  std::string stamp = "first_row";
+  r.Str("camera/stamp", &stamp);
+  if (stamp == "first_row") {
+    po->shutter.stamp = StampConvention::kFirstRow;
+  } else if (stamp == "middle_row") {
+    po->shutter.stamp = StampConvention::kMiddleRow;
+  } else if (stamp == "last_row") {
+    po->shutter.stamp = StampConvention::kLastRow;
+  } else {
+    r.Error("parameter 'camera/stamp' must be first_row, middle_row or last_row, got '" + stamp + "'");
+  }
+  r.Num("camera/row_time_offset", &po->shutter.row_time_offset_s, -0.5, 0.5);
+  r.Num("camera/virtual_focal_scale", &po->camera.virtual_focal_scale, 0.25, 4.0);
+  // IMU.
+  std::vector<double> q;
+  r.Vec("imu/R_cam_imu", &q);
+  if (!q.empty()) {
+    if (q.size() != 4) {
+      r.Error("parameter 'imu/R_cam_imu' must be a quaternion [x, y, z, w]");
+    } else {
+      Eigen::Quaterniond e(q[3], q[0], q[1], q[2]);
+      if (!(e.norm() > 0.5 && e.norm() < 2.0)) {
+        r.Error("parameter 'imu/R_cam_imu' must be a unit quaternion [x, y, z, w]");
+      } else {
+        po->imu.R_cam_imu = e.normalized();
+      }
+    }
+  }
+  r.Num("imu/time_offset", &po->imu.imu_time_offset_s, -1.0, 1.0);
+  r.Num("imu/buffer_duration", &po->imu.buffer_duration_s, 0.5, 600.0);
+  r.Int("imu/max_samples", &po->imu.max_samples, 16, 10000000);
+  r.Num("imu/max_angular_rate", &po->imu.max_angular_rate, 0.1, 1000.0);
+  r.Num("imu/max_gap", &po->imu.max_gap_s, 0.001, 10.0);
+  r.Num("imu/max_extrapolation", &po->imu.max_extrapolation_s, 0.0, 1.0);
+  // Face.
+  FaceTrackerOptions& f = po->face;
+  std::string det = f.detector.type == FaceDetectorType::kOpenCvCascade ? "opencv_cascade" : "dlib_hog";
+  r.Str("face/detector", &det);
+  if (det == "dlib_hog") {
+    f.detector.type = FaceDetectorType::kDlibHog;
+  } else if (det == "opencv_cascade") {
+    f.detector.type = FaceDetectorType::kOpenCvCascade;
+  } else {
+    r.Error("parameter 'face/detector' must be dlib_hog or opencv_cascade, got '" + det + "'");
+  }
+  r.Int("face/detector_max_side", &f.detector.max_side_px, 64, 8192);
+  r.Str("face/cascade_path", &f.detector.cascade_path);
+  r.Num("face/dlib_threshold", &f.detector.dlib_threshold, -2.0, 5.0);
+  r.Int("face/min_face_px", &f.detector.min_face_px, 8, 4096);
+  r.Str("face/landmark_model", &f.landmark_model_path);
+  r.Int("face/redetect_every", &f.redetect_every_frames, 1, 10000);
+  r.Num("face/redetect_region_scale", &f.redetect_region_scale, 1.0, 10.0);
+  r.Int("face/redetect_face_px", &f.redetect_face_px, 60, 1000);
+  r.Num("face/lost_timeout", &f.lost_timeout_s, 0.0, 60.0);
+  r.Num("face/max_shape_residual", &f.max_shape_residual, 0.001, 2.0);
+  r.Num("face/min_spread_ratio", &f.min_spread_ratio, 0.01, 10.0);
+  r.Num("face/max_spread_ratio", &f.max_spread_ratio, 0.01, 10.0);
+  r.Num("face/max_jump", &f.max_jump, 0.01, 20.0);
+  r.Num("face/min_appearance", &f.min_appearance, -1.0, 0.999);
+  r.Bool("face/estimate_head_pose", &f.estimate_head_pose);
+  // Stabilizer.
+  StabilizerOptions& s = po->stabilizer;
+  r.Num("head/w_stay", &s.head.w_stay, 0.0, 1e9);
+  r.Num("head/w_follow", &s.head.w_follow, 0.0, 1e9);
+  r.Num("head/d_ref", &s.head.d_ref, 1e-6, 1.0);
+  r.Num("weights/fit", &s.weights.fit, 0.0, 1e6);
+  r.Num("weights/distortion", &s.weights.distortion, 0.0, 1e6);
+  r.Num("weights/follow", &s.weights.follow, 0.0, 1e6);
+  r.Num("weights/rotation_c0", &s.weights.rotation_c0, 0.0, 1e6);
+  r.Num("weights/rotation_c1", &s.weights.rotation_c1, 0.0, 1e6);
+  r.Num("weights/translation_c0", &s.weights.translation_c0, 1e-6, 1e6);
+  r.Num("weights/translation_c1", &s.weights.translation_c1, 0.0, 1e6);
+  r.Num("weights/protrusion", &s.weights.protrusion, 0.0, 1e6);
+  r.Num("terms/distortion_threshold", &s.terms.distortion_threshold_rad, 0.0, 1.5);
+  r.Num("terms/distortion_slope", &s.terms.distortion_slope, 1.0, 1e4);
+  r.Num("terms/protrusion_alpha", &s.terms.protrusion_alpha, 1e-5, 1.0);
+  r.Num("terms/protrusion_shrink", &s.terms.protrusion_shrink, 0.0, 0.2);
+  r.Int("terms/protrusion_samples_per_edge", &s.terms.protrusion_samples_per_edge, 2, 256);
+  r.Bool("dynamic/enabled", &s.dynamic.enabled);
+  r.Num("dynamic/fade_time", &s.dynamic.fade_time_s, 0.0, 10.0);
+  r.Num("dynamic/gyro_window", &s.dynamic.gyro_window_s, 0.02, 10.0);
+  r.Num("dynamic/gyro_still", &s.dynamic.gyro_still_rad_s, 0.0, 10.0);
+  r.Num("dynamic/gyro_active", &s.dynamic.gyro_active_rad_s, 1e-6, 20.0);
+  r.Num("dynamic/gyro_still_fit_scale", &s.dynamic.gyro_still_fit_scale, 0.0, 1.0);
+  r.Num("dynamic/pose_low", &s.dynamic.pose_low_rad, 0.0, 1.6);
+  r.Num("dynamic/pose_high", &s.dynamic.pose_high_rad, 1e-6, 3.2);
+  r.Num("dynamic/pose_min_fit_scale", &s.dynamic.pose_min_fit_scale, 0.0, 1.0);
+  r.Num("dynamic/pose_smoothness_boost", &s.dynamic.pose_smoothness_boost, 0.0, 100.0);
+  r.Int("dynamic/variation_window", &s.dynamic.variation_window, 3, 1000);
+  r.Num("dynamic/centre_variation_low", &s.dynamic.centre_variation_low, 0.0, 1.0);
+  r.Num("dynamic/centre_variation_high", &s.dynamic.centre_variation_high, 1e-9, 2.0);
+  r.Num("dynamic/scale_variation_low", &s.dynamic.scale_variation_low, 0.0, 10.0);
+  r.Num("dynamic/scale_variation_high", &s.dynamic.scale_variation_high, 1e-9, 20.0);
+  r.Num("dynamic/variation_min_fit_scale", &s.dynamic.variation_min_fit_scale, 0.0, 1.0);
+  r.Int("solver/max_iterations", &s.solver.max_iterations, 1, 1000);
+  r.Num("solver/function_tolerance", &s.solver.function_tolerance, 1e-16, 0.1);
+  r.Num("solver/max_time", &s.solver.max_time_s, 1e-4, 10.0);
+  r.Int("stabilizer/protrusion_search_steps", &s.protrusion_search_steps, 1, 60);
+  r.Int("stabilizer/row_rotation_samples", &s.row_rotation_samples, 1, 4096);
+  r.Num("stabilizer/min_face_confidence", &s.min_face_confidence, 0.0, 1.0);
+  r.Bool("stabilizer/gyro_only", &s.gyro_only);
+  r.Bool("stabilizer/smooth_head_in_virtual_view", &s.smooth_head_in_virtual_view);
+  r.Num("stabilizer/intentional_window", &s.intentional_window_s, 0.0, 5.0);
+  // Output and warp.
+  r.Num("output/crop_ratio", &po->warp.output.crop_ratio, 0.0, 0.4);
+  r.Int("output/width", &po->warp.output.width, 0, 16384);
+  r.Int("output/height", &po->warp.output.height, 0, 16384);
+  r.Int("warp/mesh_cols", &po->warp.mesh_cols, 1, 512);
+  r.Int("warp/mesh_rows", &po->warp.mesh_rows, 1, 512);
+  r.Int("warp/num_threads", &po->warp.num_threads, 0, 256);
+  r.Bool("warp/fixed_point_maps", &po->warp.fixed_point_maps);
+  Status st = r.status();
+  if (!st.ok()) return st;
+  // Cross-field checks of the core (e.g. low < high) with its own messages.
+  return ValidatePipelineOptions(*po);
+}
+
+void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::StabilizerOptions* o) {
+  o->weights.fit = c.w_fit;
+  o->weights.distortion = c.w_distortion;
+  o->weights.follow = c.w_follow;
+  o->weights.rotation_c0 = c.w_rotation_c0;
+  o->weights.rotation_c1 = c.w_rotation_c1;
+  o->weights.translation_c0 = c.w_translation_c0;
+  o->weights.translation_c1 = c.w_translation_c1;
+  o->weights.protrusion = c.w_protrusion;
+  o->terms.distortion_threshold_rad = c.distortion_threshold;
+  o->terms.distortion_slope = c.distortion_slope;
+  o->terms.protrusion_alpha = c.protrusion_alpha;
+  o->terms.protrusion_shrink = c.protrusion_shrink;
+  o->head.w_stay = c.head_w_stay;
+  o->head.w_follow = c.head_w_follow;
+  o->head.d_ref = c.head_d_ref;
+  o->dynamic.enabled = c.dynamic_enabled;
+  o->dynamic.fade_time_s = c.fade_time;
+  o->dynamic.gyro_still_rad_s = c.gyro_still;
+  o->dynamic.gyro_active_rad_s = std::max(c.gyro_active, c.gyro_still + 1e-4);
+  o->dynamic.pose_low_rad = c.pose_low;
+  o->dynamic.pose_high_rad = std::max(c.pose_high, c.pose_low + 1e-3);
+  o->gyro_only = c.gyro_only;
+  o->min_face_confidence = c.min_face_confidence;
+}
+
+steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptions& o) {
+  steadiface::SteadifaceConfig c = steadiface::SteadifaceConfig::__getDefault__();
+  c.w_fit = o.weights.fit;
+  c.w_distortion = o.weights.distortion;
+  c.w_follow = o.weights.follow;
+  c.w_rotation_c0 = o.weights.rotation_c0;
+  c.w_rotation_c1 = o.weights.rotation_c1;
+  c.w_translation_c0 = o.weights.translation_c0;
+  c.w_translation_c1 = o.weights.translation_c1;
+  c.w_protrusion = o.weights.protrusion;
+  c.distortion_threshold = o.terms.distortion_threshold_rad;
+  c.distortion_slope = o.terms.distortion_slope;
+  c.protrusion_alpha = o.terms.protrusion_alpha;
+  c.protrusion_shrink = o.terms.protrusion_shrink;
+  c.head_w_stay = o.head.w_stay;
+  c.head_w_follow = o.head.w_follow;
+  c.head_d_ref = o.head.d_ref;
+  c.dynamic_enabled = o.dynamic.enabled;
+  c.fade_time = o.dynamic.fade_time_s;
+  c.gyro_still = o.dynamic.gyro_still_rad_s;
+  c.gyro_active = o.dynamic.gyro_active_rad_s;
+  c.pose_low = o.dynamic.pose_low_rad;
+  c.pose_high = o.dynamic.pose_high_rad;
+  c.gyro_only = o.gyro_only;
+  c.min_face_confidence = o.min_face_confidence;
+  return c;
+}
+
+}  // namespace steadiface_ros

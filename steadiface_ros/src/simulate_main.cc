@@ -1,0 +1,161 @@
+// steadiface_simulate: renders a simulator preset into a ROS bag
+// (sensor_msgs/Image bgr8 or mono8, CameraInfo, Imu with angular velocity
+// and orientation_covariance[0] = -1) plus a ground-truth CSV sidecar.
+//
+//   rosrun steadiface steadiface_simulate --preset walk --out walk.bag
+//       [--duration 3] [--size 640x360] [--fps 30] [--imu-rate 200]
+//       [--seed 1] [--mono] [--data DIR] [--clock-offset S]
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgproc.hpp>
+#include <ros/package.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/image_encodings.h>
+
+#include "steadiface_core/sim/simulator.h"
+#include "steadiface_ros/msg_conversion.h"
+#include "steadiface_ros/time_conversion.h"
+
+namespace {
+
+int Usage() {
+  std::cerr << "usage: steadiface_simulate --preset NAME --out FILE.bag [--duration S]\n"
+               "  [--size WxH] [--fps F] [--imu-rate HZ] [--seed N] [--mono] [--data DIR]\n"
+               "  [--clock-offset S] [--readout S] [--epoch S]\n"
+               "presets: still walk pan run occlusion two_faces turn_away\n";
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  steadiface::sim::SimulatorOptions o;
+  std::string preset = "walk", out, data;
+  bool mono = false;
+  double epoch = 1.7e9;  // bag stamps start here (a realistic ROS time)
+  double readout = -1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+    if (a == "--preset") preset = next();
+    else if (a == "--out") out = next();
+    else if (a == "--duration") o.duration_s = std::atof(next().c_str());
+    else if (a == "--fps") o.fps = std::atof(next().c_str());
+    else if (a == "--imu-rate") o.imu_rate_hz = std::atof(next().c_str());
+    else if (a == "--seed") o.seed = std::strtoull(next().c_str(), nullptr, 10);
+    else if (a == "--mono") mono = true;
+    else if (a == "--data") data = next();
+    else if (a == "--clock-offset") o.imu_clock_offset_s = std::atof(next().c_str());
+    else if (a == "--readout") readout = std::atof(next().c_str());
+    else if (a == "--epoch") epoch = std::atof(next().c_str());
+    else if (a == "--size") {
+      if (std::sscanf(next().c_str(), "%dx%d", &o.width, &o.height) != 2) return Usage();
+    } else {
+      return Usage();
+    }
+  }
+  if (out.empty()) return Usage();
+  if (data.empty()) data = ros::package::getPath("steadiface") + "/test/data";
+  o.data_dir = data;
+  const double duration = o.duration_s;
+  steadiface::Status s = steadiface::sim::ApplyPreset(preset, &o);
+  o.duration_s = duration;
+  if (readout >= 0) o.readout_s = readout;
+  std::unique_ptr<steadiface::sim::Simulator> sim;
+  if (s.ok()) s = steadiface::sim::Simulator::Create(o, &sim);
+  if (!s.ok()) {
+    std::cerr << "steadiface_simulate: " << s.message() << "\n";
+    return 1;
+  }
+  const std::string tmp = out + ".part";
+  rosbag::Bag bag;
+  try {
+    bag.open(tmp, rosbag::bagmode::Write);
+  } catch (const rosbag::BagException& e) {
+    std::cerr << "steadiface_simulate: cannot write " << tmp << ": " << e.what() << "\n";
+    return 1;
+  }
+  const ros::Duration shift(epoch);
+  auto to_ros = [&](steadiface::Time t) { return steadiface_ros::ToRosTime(t) + shift; };
+  // IMU and frames interleaved in time order (as a recording would be).
+  const auto& imu = sim->imu();
+  size_t g = 0;
+  sensor_msgs::CameraInfo info;
+  const steadiface::CameraIntrinsics& k = sim->intrinsics();
+  info.header.frame_id = "camera_optical";
+  info.width = k.width;
+  info.height = k.height;
+  info.distortion_model = "plumb_bob";
+  info.D = {0, 0, 0, 0, 0};
+  info.K = {k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0};
+  std::ofstream csv(out + ".truth.csv");
+  csv << "frame,stamp,head_x,head_y,head_in_view,face_scale_px,occluded,face_out,second_face";
+  for (int r = 0; r < 16; ++r) csv << ",row" << r << "_qx,row" << r << "_qy,row" << r << "_qz,row" << r << "_qw";
+  csv << "\n";
+  csv.precision(12);
+  for (int i = 0; i < sim->num_frames(); ++i) {
+    cv::Mat frame;
+    steadiface::sim::SimTruth truth;
+    sim->Render(i, &frame, &truth);
+    const ros::Time stamp = to_ros(truth.stamp);
+    // The camera's last row is captured at stamp + readout; IMU samples up
+    // to then are recorded before the image.
+    const ros::Time last_row = stamp + ros::Duration(o.readout_s);
+    while (g < imu.size() && to_ros(imu[g].stamp) <= last_row) {
+      sensor_msgs::Imu m;
+      m.header.stamp = to_ros(imu[g].stamp);
+      m.header.frame_id = "camera_optical";
+      m.angular_velocity.x = imu[g].angular_velocity.x();
+      m.angular_velocity.y = imu[g].angular_velocity.y();
+      m.angular_velocity.z = imu[g].angular_velocity.z();
+      m.orientation_covariance[0] = -1;
+      bag.write("/imu", m.header.stamp, m);
+      ++g;
+    }
+    cv::Mat img = frame;
+    std::string enc = sensor_msgs::image_encodings::BGR8;
+    if (mono) {
+      cv::cvtColor(frame, img, cv::COLOR_BGR2GRAY);
+      enc = sensor_msgs::image_encodings::MONO8;
+    }
+    std_msgs::Header h;
+    h.stamp = stamp;
+    h.frame_id = "camera_optical";
+    h.seq = i;
+    info.header = h;
+    bag.write("/camera/image_raw", stamp + ros::Duration(o.readout_s), cv_bridge::CvImage(h, enc, img).toImageMsg());
+    bag.write("/camera/camera_info", stamp + ros::Duration(o.readout_s), info);
+    csv << i << "," << stamp.toSec() << "," << truth.head_px.x() << "," << truth.head_px.y() << ","
+        << truth.head_in_view << "," << truth.face_scale_px << "," << truth.occluded << ","
+        << truth.face_out << "," << truth.second_face;
+    for (const auto& q : truth.R_r) csv << "," << q.x() << "," << q.y() << "," << q.z() << "," << q.w();
+    csv << "\n";
+  }
+  for (; g < imu.size(); ++g) {
+    sensor_msgs::Imu m;
+    m.header.stamp = to_ros(imu[g].stamp);
+    m.header.frame_id = "camera_optical";
+    m.angular_velocity.x = imu[g].angular_velocity.x();
+    m.angular_velocity.y = imu[g].angular_velocity.y();
+    m.angular_velocity.z = imu[g].angular_velocity.z();
+    m.orientation_covariance[0] = -1;
+    bag.write("/imu", m.header.stamp, m);
+  }
+  bag.close();
+  if (std::rename(tmp.c_str(), out.c_str()) != 0) {
+    std::cerr << "steadiface_simulate: cannot rename " << tmp << "\n";
+    return 1;
+  }
+  std::cout << "wrote " << out << " (" << sim->num_frames() << " frames " << k.width << "x"
+            << k.height << (mono ? " mono8" : " bgr8") << ", " << imu.size() << " IMU samples at "
+            << o.imu_rate_hz << " Hz) and " << out << ".truth.csv\n";
+  return 0;
+}

@@ -1,0 +1,265 @@
+#include "steadiface_ros/stabilizer_ros.h"
+
+
+#include "steadiface_ros/msg_conversion.h"
+
+namespace steadiface_ros {
+
+StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std::string& name)
+    : nh_(nh), pnh_(pnh), name_(name) {
+  // 1. Parameters.
+  std::unique_ptr<ParamSource> params = RosParams(pnh_);
+  const steadiface::Status s = LoadOptions(*params, &pipeline_options_, &wrapper_options_);
+  if (!s.ok()) {
+    ROS_ERROR("[%s] invalid parameters, the stabilizer will not run: %s", name_.c_str(),
+              s.message().c_str());
+    return;
+  }
+  tf_buffer_.reset(new tf2_ros::Buffer);
+  tf_listener_.reset(new tf2_ros::TransformListener(*tf_buffer_, nh_));
+  wrapper_.reset(new StabilizerWrapper(
+      pipeline_options_, wrapper_options_, this,
+      [this](const std::string& a, const std::string& b, Eigen::Quaterniond* q) {
+        return LookupExtrinsic(a, b, q);
+      }));
+
+  // 2. dynamic_reconfigure, with its own mutex; starts from the loaded options.
+  reconfigure_.reset(
+      new dynamic_reconfigure::Server<steadiface::SteadifaceConfig>(reconfigure_mutex_, pnh_));
+  {
+    boost::recursive_mutex::scoped_lock lock(reconfigure_mutex_);
+    reconfigure_->updateConfig(ConfigFromOptions(pipeline_options_.stabilizer));
+  }
+  reconfigure_->setCallback(
+      [this](steadiface::SteadifaceConfig& c, uint32_t level) { OnReconfigure(c, level); });
+
+  // 3. Publishers.
+  it_.reset(new image_transport::ImageTransport(nh_));
+  // Its own camera namespace, so its camera_info does not collide with the
+  // input's: image_stabilized/image_raw + image_stabilized/camera_info.
+  image_pub_ = it_->advertiseCamera("image_stabilized/image_raw", 5);
+  debug_pub_ = it_->advertise("debug_image", 2);
+  landmarks_pub_ = nh_.advertise<steadiface::FaceLandmarks>("face_landmarks", 10);
+  state_pub_ = nh_.advertise<steadiface::StabilizerState>("state", 10);
+
+  // Diagnostics.
+  updater_.reset(new diagnostic_updater::Updater(nh_, pnh_));
+  updater_->setHardwareID("steadiface");
+  if (wrapper_options_.expected_image_rate > 0) {
+    image_min_rate_ = 0.8 * wrapper_options_.expected_image_rate;
+    image_max_rate_ = 1.2 * wrapper_options_.expected_image_rate;
+  }
+  if (wrapper_options_.expected_imu_rate > 0) {
+    imu_min_rate_ = 0.8 * wrapper_options_.expected_imu_rate;
+    imu_max_rate_ = 1.2 * wrapper_options_.expected_imu_rate;
+  }
+  image_freq_.reset(new diagnostic_updater::FrequencyStatus(
+      diagnostic_updater::FrequencyStatusParam(&image_min_rate_, &image_max_rate_, 0.1, 10),
+      "image input rate"));
+  imu_freq_.reset(new diagnostic_updater::FrequencyStatus(
+      diagnostic_updater::FrequencyStatusParam(&imu_min_rate_, &imu_max_rate_, 0.1, 10),
+      "imu input rate"));
+  updater_->add(*image_freq_);
+  updater_->add(*imu_freq_);
+  updater_->add("gyro", this, &StabilizerRos::DiagGyro);
+  updater_->add("face", this, &StabilizerRos::DiagFace);
+  updater_->add("solver", this, &StabilizerRos::DiagSolver);
+  updater_->add("frames", this, &StabilizerRos::DiagFrames);
+  updater_->add("protrusion", this, &StabilizerRos::DiagProtrusion);
+
+  // 4. Subscribers: IMU never lazy, with a large queue.
+  imu_sub_ = nh_.subscribe("imu", 2000, &StabilizerRos::OnImu, this,
+                           ros::TransportHints().tcpNoDelay());
+  image_sub_ = it_->subscribeCamera("image_raw", 5, &StabilizerRos::OnImage, this);
+  if (pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal) {
+    landmarks_sub_ = nh_.subscribe("landmarks_in", 10, &StabilizerRos::OnLandmarks, this);
+  }
+  timer_ = nh_.createTimer(ros::Duration(0.01), &StabilizerRos::OnTimer, this);
+  last_imu_wall_ = ros::WallTime::now();
+  ok_ = true;
+  ROS_INFO("[%s] ready: image_raw + camera_info -> image_stabilized, imu, landmark source %s",
+           name_.c_str(),
+           pipeline_options_.landmark_source == steadiface::LandmarkSource::kDlib
+               ? "dlib"
+               : pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal
+                     ? "topic"
+                     : "none");
+}
+
+StabilizerRos::~StabilizerRos() {
+  // Stop the inputs first so nothing calls into a half-destroyed object.
+  timer_.stop();
+  image_sub_.shutdown();
+  imu_sub_.shutdown();
+  landmarks_sub_.shutdown();
+  reconfigure_.reset();
+}
+
+void StabilizerRos::OnImage(const sensor_msgs::ImageConstPtr& image,
+                            const sensor_msgs::CameraInfoConstPtr& info) {
+  image_freq_->tick();
+  wrapper_->OnImage(image, info, ros::Time::now());
+}
+
+void StabilizerRos::OnImu(const sensor_msgs::ImuConstPtr& msg) {
+  imu_freq_->tick();
+  imu_seen_ = true;
+  last_imu_wall_ = ros::WallTime::now();
+  wrapper_->OnImu(*msg);
+}
+
+void StabilizerRos::OnLandmarks(const steadiface::FaceLandmarksConstPtr& msg) {
+  wrapper_->OnLandmarks(*msg);
+}
+
+void StabilizerRos::OnTimer(const ros::TimerEvent&) {
+  wrapper_->OnTimer(ros::Time::now());
+  updater_->update();
+}
+
+void StabilizerRos::OnReconfigure(steadiface::SteadifaceConfig& config, uint32_t) {
+  // Only assigns: the wrapper applies it on the next frame.
+  steadiface::StabilizerOptions o = wrapper_->pipeline_options().stabilizer;
+  ApplyConfig(config, &o);
+  wrapper_->RequestStabilizerOptions(o);
+}
+
+bool StabilizerRos::LookupExtrinsic(const std::string& imu_frame,
+                                    const std::string& camera_frame, Eigen::Quaterniond* q) {
+  try {
+    // Rotation taking IMU-frame vectors into the camera frame.
+    const geometry_msgs::TransformStamped t =
+        tf_buffer_->lookupTransform(camera_frame, imu_frame, ros::Time(0), ros::Duration(0.05));
+    const auto& r = t.transform.rotation;
+    Eigen::Quaterniond e(r.w, r.x, r.y, r.z);
+    if (!(e.norm() > 0.5)) return false;
+    *q = e.normalized();
+    ROS_INFO("[%s] IMU->camera rotation from TF (%s -> %s)", name_.c_str(), imu_frame.c_str(),
+             camera_frame.c_str());
+    return true;
+  } catch (const tf2::TransformException&) {
+    return false;
+  }
+}
+
+void StabilizerRos::PublishImage(const sensor_msgs::ImagePtr& image,
+                                 const sensor_msgs::CameraInfoPtr& info) {
+  image_pub_.publish(image, info);
+}
+void StabilizerRos::PublishLandmarks(const steadiface::FaceLandmarks& msg) {
+  landmarks_pub_.publish(msg);
+}
+void StabilizerRos::PublishState(const steadiface::StabilizerState& msg) { state_pub_.publish(msg); }
+void StabilizerRos::PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) {
+  if (!tf.empty()) tf_broadcaster_.sendTransform(tf);
+}
+bool StabilizerRos::WantsDebugImage() const { return debug_pub_.getNumSubscribers() > 0; }
+void StabilizerRos::PublishDebugImage(const sensor_msgs::ImagePtr& image) {
+  debug_pub_.publish(image);
+}
+void StabilizerRos::Warn(const std::string& key, const std::string& text) {
+  ROS_WARN_STREAM_THROTTLE_NAMED(5.0, key, "[" << name_ << "] " << text);
+}
+void StabilizerRos::Error(const std::string& key, const std::string& text) {
+  ROS_ERROR_STREAM_THROTTLE_NAMED(5.0, key, "[" << name_ << "] " << text);
+}
+
+void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const WrapperStatus w = wrapper_->Status();
+  const double since = (ros::WallTime::now() - last_imu_wall_).toSec();
+  s.add("imu messages", w.counters.imu_in);
+  s.add("imu rejected", w.counters.imu_rejected);
+  s.add("imu gaps", w.counters.imu_gaps);
+  s.add("seconds since imu", since);
+  s.add("gyro latency past last row [s]", w.gyro_latency_s);
+  s.add("frames with extrapolated gyro", w.counters.extrapolated);
+  s.add("frames passed through without imu", w.counters.passthrough);
+  s.add("time jumps", w.counters.time_jumps);
+  for (size_t i = 1; i < w.timeline.samples.size(); ++i) {
+    s.add(std::string("rejected ") +
+              steadiface::SampleResultName(static_cast<steadiface::SampleResult>(i)),
+          w.timeline.samples[i]);
+  }
+  if (!imu_seen_ && since > wrapper_options_.imu_timeout_s) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no IMU data: frames are not stabilized");
+  } else if (since > wrapper_options_.imu_timeout_s) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "IMU stopped");
+  } else if (w.counters.imu_rejected > 0 || w.counters.imu_gaps > 0 || w.counters.extrapolated > 0) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+              "IMU rejects, gaps or extrapolated frames (see values)");
+  } else {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "gyro covers every frame");
+  }
+}
+
+void StabilizerRos::DiagFace(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const WrapperStatus w = wrapper_->Status();
+  s.add("state", steadiface::TrackingStateName(w.face_state));
+  s.add("failure", w.face_failure);
+  s.add("confidence", w.face_confidence);
+  s.add("landmarks_in rejected", w.counters.landmarks_bad);
+  if (pipeline_options_.landmark_source == steadiface::LandmarkSource::kNone) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "face processing off (gyro-only)");
+  } else if (w.face_state == steadiface::TrackingState::kLost) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+              "face of interest lost (" + w.face_failure + "): fading to gyro-only");
+  } else if (w.face_state == steadiface::TrackingState::kTracking) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking the face of interest");
+  } else {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "no face: gyro-only stabilization");
+  }
+}
+
+void StabilizerRos::DiagSolver(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const WrapperStatus w = wrapper_->Status();
+  s.add("last termination", w.last_solver_termination);
+  s.add("last iterations", w.last_solver_iterations);
+  s.add("last time [ms]", w.last_solver_ms);
+  s.add("failures (previous solution kept)", w.stabilizer.solver_failures);
+  s.add("frames", w.stabilizer.frames);
+  if (w.stabilizer.solver_failures > reported_solver_failures_) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "solver failed; previous solution kept");
+  } else {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "solver healthy");
+  }
+  reported_solver_failures_ = w.stabilizer.solver_failures;
+}
+
+void StabilizerRos::DiagFrames(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const WrapperStatus w = wrapper_->Status();
+  const WrapperCounters& c = w.counters;
+  s.add("images in", c.images_in);
+  s.add("frames out", c.frames_out);
+  s.add("dropped: bad image", c.dropped_bad_image);
+  s.add("dropped: bad camera_info", c.dropped_bad_info);
+  s.add("dropped: no gyro", c.dropped_no_gyro);
+  s.add("dropped: queue full", c.dropped_queue_full);
+  s.add("dropped: old stamp", c.dropped_old_stamp);
+  s.add("dropped: refused", c.dropped_pipeline_error);
+  s.add("geometry rebuilds", c.rebuilds);
+  s.add("last error", w.last_error);
+  const uint64_t drops = c.dropped_bad_image + c.dropped_bad_info + c.dropped_no_gyro +
+                         c.dropped_queue_full + c.dropped_old_stamp + c.dropped_pipeline_error;
+  if (drops > reported_drops_) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "frames dropped: " + w.last_error);
+  } else {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "no frames dropped since last report");
+  }
+  reported_drops_ = drops;
+}
+
+void StabilizerRos::DiagProtrusion(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const WrapperStatus w = wrapper_->Status();
+  s.add("binary searches", w.stabilizer.protrusion_searches);
+  s.add("previous-warp fallbacks", w.stabilizer.previous_warp_fallbacks);
+  s.add("frames with undefined pixels", w.stabilizer.undefined_frames);
+  const uint64_t f = w.stabilizer.previous_warp_fallbacks + w.stabilizer.undefined_frames;
+  if (f > reported_fallbacks_) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "previous warp reused (no valid pose)");
+  } else {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "no protrusion fallback");
+  }
+  reported_fallbacks_ = f;
+}
+
+}  // namespace steadiface_ros

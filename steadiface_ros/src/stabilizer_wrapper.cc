@@ -1,0 +1,374 @@
+#include "steadiface_ros/stabilizer_wrapper.h"
+
+#include <cv_bridge/cv_bridge.h>
+#include <sensor_msgs/image_encodings.h>
+
+#include "steadiface_core/debug_overlay.h"
+#include "steadiface_ros/msg_conversion.h"
+#include "steadiface_ros/time_conversion.h"
+
+namespace steadiface_ros {
+namespace {
+
+// A backwards step larger than this is a new epoch (bag loop, /clock reset).
+constexpr double kTimeJumpS = 1.0;
+
+bool SameGeometry(const sensor_msgs::CameraInfo& a, const sensor_msgs::CameraInfo& b) {
+  return a.width == b.width && a.height == b.height && a.K == b.K && a.D == b.D &&
+         a.distortion_model == b.distortion_model && a.binning_x == b.binning_x &&
+         a.binning_y == b.binning_y && a.roi.x_offset == b.roi.x_offset &&
+         a.roi.y_offset == b.roi.y_offset && a.roi.width == b.roi.width &&
+         a.roi.height == b.roi.height;
+}
+
+}  // namespace
+
+StabilizerWrapper::StabilizerWrapper(const steadiface::PipelineOptions& pipeline,
+                                     const WrapperOptions& options, OutputSink* sink,
+                                     ExtrinsicLookup extrinsic_lookup)
+    : options_(pipeline),
+      wrapper_options_(options),
+      sink_(sink),
+      extrinsic_lookup_(std::move(extrinsic_lookup)) {}
+
+void StabilizerWrapper::RequestStabilizerOptions(const steadiface::StabilizerOptions& o) {
+  std::lock_guard<std::mutex> lock(options_mutex_);
+  requested_options_ = o;
+  options_pending_ = true;
+}
+
+void StabilizerWrapper::ApplyPendingOptions() {
+  steadiface::StabilizerOptions o;
+  {
+    std::lock_guard<std::mutex> lock(options_mutex_);
+    if (!options_pending_) return;
+    o = requested_options_;
+    options_pending_ = false;
+  }
+  if (pipeline_) {
+    const steadiface::Status s = pipeline_->UpdateStabilizerOptions(o);
+    if (!s.ok()) {
+      sink_->Error("reconfigure", "reconfigure rejected: " + s.message());
+      return;
+    }
+  }
+  options_.stabilizer = o;
+}
+
+void StabilizerWrapper::ResetAll(const char* why) {
+  ++counters_.time_jumps;
+  sink_->Warn("time_jump", std::string("time jumped backwards (") + why +
+                               "): resetting gyro timeline, face tracker and stabilizer");
+  if (pipeline_) pipeline_->Reset();
+  recent_gyro_.clear();
+  queue_.clear();
+  last_frame_stamp_ = ros::Time();
+  last_tf_stamp_ = ros::Time();
+  have_last_imu_ = false;
+}
+
+void StabilizerWrapper::OnImu(const sensor_msgs::Imu& msg) {
+  ++counters_.imu_in;
+  if (imu_frame_.empty()) imu_frame_ = msg.header.frame_id;
+  if (have_last_imu_ && msg.header.stamp + ros::Duration(kTimeJumpS) < last_imu_stamp_) {
+    ResetAll("IMU stamp");
+  }
+  if (have_last_imu_ && msg.header.stamp > last_imu_stamp_ &&
+      (msg.header.stamp - last_imu_stamp_).toSec() > wrapper_options_.imu_gap_warn_s) {
+    ++counters_.imu_gaps;
+    sink_->Warn("imu_gap", "IMU gap of " +
+                               std::to_string((msg.header.stamp - last_imu_stamp_).toSec()) +
+                               " s");
+  }
+  const steadiface::GyroSample g = ToGyroSample(msg);
+  steadiface::SampleResult r = steadiface::SampleResult::kAccepted;
+  if (pipeline_) {
+    r = pipeline_->AddGyro(g);
+  } else if (!g.angular_velocity.allFinite()) {
+    r = steadiface::SampleResult::kNonFinite;
+  }
+  if (r != steadiface::SampleResult::kAccepted) {
+    ++counters_.imu_rejected;
+    sink_->Warn(std::string("imu_") + steadiface::SampleResultName(r),
+                std::string("IMU sample rejected: ") + steadiface::SampleResultName(r));
+    return;
+  }
+  if (!have_last_imu_ || msg.header.stamp > last_imu_stamp_) {
+    last_imu_stamp_ = msg.header.stamp;
+    have_last_imu_ = true;
+  }
+  // Keep a bounded copy for rebuilding the pipeline (geometry change).
+  recent_gyro_.push_back(g);
+  const steadiface::Duration keep = steadiface::FromSeconds(options_.imu.buffer_duration_s);
+  while (!recent_gyro_.empty() &&
+         (recent_gyro_.back().stamp - recent_gyro_.front().stamp > keep ||
+          recent_gyro_.size() > static_cast<size_t>(options_.imu.max_samples))) {
+    recent_gyro_.pop_front();
+  }
+  // Frames the gyro now covers; waits run out in OnTimer / OnImage.
+  Drain(ros::Time(), false);
+}
+
+void StabilizerWrapper::OnLandmarks(const steadiface::FaceLandmarks& msg) {
+  std::vector<Eigen::Vector2d> pts;
+  double conf = 0.0;
+  const steadiface::Status s = FromMsg(msg, &pts, &conf);
+  if (!s.ok()) {
+    ++counters_.landmarks_bad;
+    sink_->Warn("landmarks_in", s.message());
+    pts.clear();
+  }
+  external_landmarks_ = pts;
+  external_confidence_ = conf;
+  last_external_stamp_ = msg.header.stamp;
+}
+
+bool StabilizerWrapper::EnsurePipeline(const sensor_msgs::CameraInfo& info,
+                                       const std::string& frame_id) {
+  if (pipeline_ && SameGeometry(info, pipeline_info_)) return true;
+  steadiface::CameraIntrinsics k;
+  steadiface::Status s = ToCameraIntrinsics(info, &k);
+  if (!s.ok()) {
+    ++counters_.dropped_bad_info;
+    sink_->Error("camera_info", s.message());
+    status_.last_error = s.message();
+    return false;
+  }
+  steadiface::PipelineOptions o = options_;
+  if (wrapper_options_.imu_extrinsics_from_tf && extrinsic_lookup_ && !imu_frame_.empty() &&
+      imu_frame_ != frame_id && !extrinsic_resolved_) {
+    Eigen::Quaterniond q;
+    if (extrinsic_lookup_(imu_frame_, frame_id, &q)) {
+      o.imu.R_cam_imu = q;
+      options_.imu.R_cam_imu = q;
+      extrinsic_resolved_ = true;
+    } else {
+      sink_->Warn("extrinsics", "no TF from IMU frame '" + imu_frame_ + "' to camera frame '" +
+                                    frame_id + "' yet; using imu/R_cam_imu");
+    }
+  }
+  std::unique_ptr<steadiface::Pipeline> p;
+  s = steadiface::Pipeline::Create(k, o, &p);
+  if (!s.ok()) {
+    sink_->Error("pipeline", "cannot build the stabilizer: " + s.message());
+    status_.last_error = s.message();
+    return false;
+  }
+  if (pipeline_) ++counters_.rebuilds;
+  for (const auto& g : recent_gyro_) p->AddGyro(g);
+  pipeline_ = std::move(p);
+  pipeline_info_ = info;
+  last_frame_stamp_ = ros::Time();
+  return true;
+}
+
+void StabilizerWrapper::OnImage(const sensor_msgs::ImageConstPtr& image,
+                                const sensor_msgs::CameraInfoConstPtr& info,
+                                const ros::Time& now) {
+  ++counters_.images_in;
+  if (!image || !info) {
+    ++counters_.dropped_bad_info;
+    sink_->Error("camera_info", "image without camera_info");
+    return;
+  }
+  if (!last_frame_stamp_.isZero() &&
+      image->header.stamp + ros::Duration(kTimeJumpS) < last_frame_stamp_) {
+    ResetAll("image stamp");
+  }
+  const ros::Time newest_queued = queue_.empty() ? last_frame_stamp_ : queue_.back().image->header.stamp;
+  if (!newest_queued.isZero() && image->header.stamp <= newest_queued) {
+    ++counters_.dropped_old_stamp;
+    sink_->Warn("old_stamp", "image stamp not after the previous frame's: dropped");
+    return;
+  }
+  if (queue_.size() >= static_cast<size_t>(wrapper_options_.frame_queue_size)) {
+    ++counters_.dropped_queue_full;
+    sink_->Warn("queue_full", "frame queue full (gyro too slow?): dropping the oldest frame");
+    queue_.pop_front();
+  }
+  queue_.push_back({image, info, now});
+  Drain(now, false);
+}
+
+void StabilizerWrapper::OnTimer(const ros::Time& now) { Drain(now, false); }
+
+void StabilizerWrapper::Flush() { Drain(ros::Time(), true); }
+
+void StabilizerWrapper::Drain(const ros::Time& now, bool flush) {
+  while (!queue_.empty()) {
+    const Pending& p = queue_.front();
+    const std::string frame_id = wrapper_options_.camera_frame.empty()
+                                     ? p.image->header.frame_id
+                                     : wrapper_options_.camera_frame;
+    if (!EnsurePipeline(*p.info, frame_id)) {
+      queue_.pop_front();
+      continue;
+    }
+    const steadiface::Time stamp = ToCoreTime(p.image->header.stamp);
+    const bool covered = pipeline_->GyroCovers(stamp);
+    const bool waited_out =
+        flush || (!now.isZero() && now >= p.received &&
+                  (now - p.received).toSec() >= wrapper_options_.max_gyro_wait_s);
+    if (!covered && !waited_out) break;  // keep waiting (FIFO: later frames too)
+    const Pending item = p;
+    queue_.pop_front();
+    Process(item, !covered);
+  }
+}
+
+void StabilizerWrapper::Process(const Pending& p, bool late) {
+  ApplyPendingOptions();
+  cv::Mat image;
+  steadiface::Status s = ToCvImage(*p.image, &image);
+  if (!s.ok()) {
+    ++counters_.dropped_bad_image;
+    sink_->Error("image", s.message());
+    status_.last_error = s.message();
+    return;
+  }
+  const steadiface::CameraIntrinsics& k = pipeline_->camera_model().intrinsics();
+  if (image.cols != k.width || image.rows != k.height) {
+    ++counters_.dropped_bad_image;
+    const std::string m = "image is " + std::to_string(image.cols) + "x" +
+                          std::to_string(image.rows) + " but camera_info says " +
+                          std::to_string(k.width) + "x" + std::to_string(k.height);
+    sink_->Error("image_size", m);
+    status_.last_error = m;
+    return;
+  }
+  const steadiface::Time stamp = ToCoreTime(p.image->header.stamp);
+  const bool imu_dead =
+      !have_last_imu_ ||
+      (p.image->header.stamp - last_imu_stamp_).toSec() > wrapper_options_.imu_timeout_s;
+  steadiface::PipelineFrame frame;
+  bool extrapolated = false;
+  if (imu_dead) {
+    if (!wrapper_options_.passthrough_without_imu) {
+      ++counters_.dropped_no_gyro;
+      sink_->Error("no_imu", "no IMU data: frame dropped (passthrough_without_imu: false)");
+      return;
+    }
+    s = pipeline_->Passthrough(image, &frame);
+    if (!s.ok()) {
+      ++counters_.dropped_pipeline_error;
+      return;
+    }
+    ++counters_.passthrough;
+    sink_->Error("no_imu", "no IMU data: publishing unstabilized frames");
+    last_frame_stamp_ = p.image->header.stamp;
+    Publish(p, frame, image, false, true);
+    return;
+  }
+  if (late) {
+    if (wrapper_options_.late_frame_policy == LateFramePolicy::kDrop) {
+      ++counters_.dropped_no_gyro;
+      sink_->Warn("late_frame", "gyro did not cover the frame within max_gyro_wait: dropped");
+      return;
+    }
+    extrapolated = true;
+  }
+  const bool use_external =
+      options_.landmark_source == steadiface::LandmarkSource::kExternal;
+  // External landmarks count only for the image they were made for.
+  std::vector<Eigen::Vector2d> none;
+  const std::vector<Eigen::Vector2d>* ext =
+      use_external && last_external_stamp_ == p.image->header.stamp ? &external_landmarks_ : &none;
+  s = pipeline_->ProcessFrame(image, stamp, ext, external_confidence_, &frame);
+  if (!s.ok()) {
+    ++(late ? counters_.dropped_no_gyro : counters_.dropped_pipeline_error);
+    sink_->Warn(late ? "late_frame" : "pipeline",
+                std::string(late ? "gyro could not be extrapolated far enough: " : "frame refused: ") +
+                    s.message());
+    status_.last_error = s.message();
+    return;
+  }
+  if (extrapolated) ++counters_.extrapolated;
+  last_frame_stamp_ = p.image->header.stamp;
+  Publish(p, frame, image, extrapolated, false);
+}
+
+void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFrame& frame,
+                                const cv::Mat& input, bool extrapolated, bool passthrough) {
+  std_msgs::Header in_header = p.image->header;
+  const std::string camera_frame =
+      wrapper_options_.camera_frame.empty() ? in_header.frame_id : wrapper_options_.camera_frame;
+  std_msgs::Header out_header = in_header;
+  out_header.frame_id = camera_frame + wrapper_options_.stabilized_suffix;
+  if (!frame.output.empty()) {
+    const std::string enc = frame.output.channels() == 1
+                                ? sensor_msgs::image_encodings::MONO8
+                                : frame.output.channels() == 4 ? sensor_msgs::image_encodings::BGRA8
+                                                               : sensor_msgs::image_encodings::BGR8;
+    sensor_msgs::ImagePtr img = cv_bridge::CvImage(out_header, enc, frame.output).toImageMsg();
+    sensor_msgs::CameraInfoPtr info(
+        new sensor_msgs::CameraInfo(ToCameraInfo(frame.output_intrinsics, out_header)));
+    sink_->PublishImage(img, info);
+  }
+  if (!passthrough) {
+    std_msgs::Header lm_header = in_header;
+    lm_header.frame_id = camera_frame;
+    sink_->PublishLandmarks(ToMsg(frame.face, lm_header));
+    sink_->PublishState(ToMsg(frame, lm_header, extrapolated));
+    // TF, strictly increasing within an epoch.
+    if (last_tf_stamp_.isZero() || in_header.stamp > last_tf_stamp_) {
+      std::vector<geometry_msgs::TransformStamped> tf;
+      geometry_msgs::TransformStamped t;
+      t.header.stamp = in_header.stamp;
+      t.header.frame_id = camera_frame;
+      t.child_frame_id = out_header.frame_id;
+      // Child (virtual) coordinates -> parent (real) coordinates: R_r R_v^-1.
+      const Eigen::Quaterniond rel =
+          (frame.stabilizer.R_r * frame.stabilizer.R_v.conjugate()).normalized();
+      t.transform = ToTransformMsg(rel);
+      if (rel.coeffs().allFinite()) tf.push_back(t);
+      if (wrapper_options_.publish_world_tf) {
+        geometry_msgs::TransformStamped w;
+        w.header.stamp = in_header.stamp;
+        w.header.frame_id = wrapper_options_.world_frame;
+        w.child_frame_id = camera_frame;
+        const Eigen::Quaterniond q_wc = frame.stabilizer.R_r.conjugate().normalized();
+        w.transform = ToTransformMsg(q_wc);
+        if (q_wc.coeffs().allFinite()) tf.push_back(w);
+      }
+      sink_->PublishTf(tf);
+      last_tf_stamp_ = in_header.stamp;
+    } else {
+      ++counters_.tf_skipped;
+    }
+    if (sink_->WantsDebugImage()) {
+      cv::Mat dbg;
+      steadiface::DrawDebugOverlay(input, pipeline_->camera_model(),
+                                   pipeline_->stabilizer().protrusion(), &frame.face,
+                                   &frame.stabilizer, &dbg);
+      sink_->PublishDebugImage(
+          cv_bridge::CvImage(in_header, sensor_msgs::image_encodings::BGR8, dbg).toImageMsg());
+    }
+    status_.face_state = frame.face.state;
+    status_.face_failure = steadiface::FaceFailureName(frame.face.failure);
+    status_.face_confidence = frame.face.confidence;
+    status_.last_solver_termination = frame.stabilizer.solver.termination;
+    status_.last_solver_ms = frame.stabilizer.solver.time_ms;
+    status_.last_solver_iterations = frame.stabilizer.solver.iterations;
+    if (have_last_imu_) {
+      status_.gyro_latency_s =
+          (last_imu_stamp_ - in_header.stamp).toSec() -
+          steadiface::ToSeconds(pipeline_->LastRowTime(ToCoreTime(in_header.stamp)) -
+                                ToCoreTime(in_header.stamp));
+    }
+  }
+  ++counters_.frames_out;
+}
+
+WrapperStatus StabilizerWrapper::Status() const {
+  WrapperStatus s = status_;
+  s.counters = counters_;
+  s.pipeline_ready = pipeline_ != nullptr;
+  s.imu_ever = have_last_imu_;
+  if (pipeline_) {
+    s.timeline = pipeline_->timeline().stats();
+    s.stabilizer = pipeline_->stabilizer().stats();
+  }
+  return s;
+}
+
+}  // namespace steadiface_ros
