@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
   csv << "frame,stamp,head_x,head_y,head_in_view,face_scale_px,occluded,face_out,second_face";
   for (int r = 0; r < 16; ++r) csv << ",row" << r << "_qx,row" << r << "_qy,row" << r << "_qz,row" << r << "_qw";
   csv << "\n";
-  csv.precision(12);
+  csv.precision(17);
   for (int i = 0; i < sim->num_frames(); ++i) {
     cv::Mat frame;
     steadiface::sim::SimTruth truth;

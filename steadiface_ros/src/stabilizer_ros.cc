@@ -43,7 +43,7 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   state_pub_ = nh_.advertise<steadiface::StabilizerState>("state", 10);
 
   // Diagnostics.
-  updater_.reset(new diagnostic_updater::Updater(nh_, pnh_));
+  updater_.reset(new diagnostic_updater::Updater(nh_, pnh_, name_));
   updater_->setHardwareID("steadiface");
   if (wrapper_options_.expected_image_rate > 0) {
     image_min_rate_ = 0.8 * wrapper_options_.expected_image_rate;
