@@ -36,7 +36,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Args {
-  std::string in, out, video, report, trajectory;
+  std::string in, out, video, report, trajectory, truth, plot_dir, plot_name = "bag";
   std::vector<std::string> params;
   std::string image_topic = "camera/image_raw", info_topic = "camera/camera_info",
               imu_topic = "imu", landmarks_topic;
@@ -48,7 +48,9 @@ int Usage() {
       << "usage: steadiface_bag --in IN.bag [--out OUT.bag] [--params P.yaml]...\n"
          "  [--image TOPIC] [--info TOPIC] [--imu TOPIC] [--landmarks TOPIC]\n"
          "  [--video OUT.mp4] [--debug-overlay] [--report OUT.json]\n"
-         "  [--trajectory OUT.csv] [--gyro-only] [--quiet]\n";
+         "  [--trajectory OUT.csv] [--gyro-only] [--quiet]\n"
+         "  [--truth IN.bag.truth.csv (default: found beside the bag)]\n"
+         "  [--plots DIR --name NAME: trajectories for scripts/plot_report.py]\n";
   return 2;
 }
 
@@ -94,13 +96,16 @@ class BagSink : public steadiface_ros::OutputSink {
   std::string ns = "/camera";
   std::string T(const std::string& leaf) const { return ns + "/" + leaf; }
   sensor_msgs::ImagePtr last_image, last_debug;
+  sensor_msgs::CameraInfo last_info;
   std::vector<steadiface::StabilizerState> states;
+  std::vector<sensor_msgs::CameraInfo> infos_out;  // parallel to states
   std::vector<steadiface::FaceLandmarks> landmarks;
   std::vector<geometry_msgs::TransformStamped> tfs;
   std::map<std::string, int> warnings;
 
   void PublishImage(const sensor_msgs::ImagePtr& image, const sensor_msgs::CameraInfoPtr& info) override {
     last_image = image;
+    last_info = *info;
     if (out) {
       out->write(T("image_stabilized/image_raw"), image->header.stamp, *image);
       out->write(T("image_stabilized/camera_info"), info->header.stamp, *info);
@@ -112,6 +117,7 @@ class BagSink : public steadiface_ros::OutputSink {
   }
   void PublishState(const steadiface::StabilizerState& m) override {
     states.push_back(m);
+    infos_out.push_back(last_info);  // PublishImage precedes PublishState
     if (out) out->write(T("state"), m.header.stamp, m);
   }
   void PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) override {
@@ -155,6 +161,9 @@ int main(int argc, char** argv) {
     else if (s == "--trajectory") a.trajectory = next();
     else if (s == "--gyro-only") a.gyro_only = true;
     else if (s == "--quiet") a.quiet = true;
+    else if (s == "--truth") a.truth = next();
+    else if (s == "--plots") a.plot_dir = next();
+    else if (s == "--name") a.plot_name = next();
     else return Usage();
   }
   if (a.in.empty()) return Usage();
@@ -246,6 +255,8 @@ int main(int argc, char** argv) {
   rosbag::View view(in, rosbag::TopicQuery(topics));
   const size_t total_images = rosbag::View(in, rosbag::TopicQuery(both(a.image_topic))).size();
   std::map<ros::Time, sensor_msgs::CameraInfoConstPtr> infos;
+  sensor_msgs::CameraInfo in_info;
+  bool have_in_info = false;
   std::deque<sensor_msgs::ImageConstPtr> waiting;  // images whose info has not arrived
   cv::VideoWriter video;
   const std::string video_tmp = a.video.empty() ? "" : a.video + ".part.mp4";
@@ -289,6 +300,8 @@ int main(int argc, char** argv) {
       if (auto imu = m.instantiate<sensor_msgs::Imu>()) wrapper.OnImu(*imu);
     } else if (topic == norm(a.info_topic)) {
       if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+        in_info = *info;
+        have_in_info = true;
         infos[info->header.stamp] = info;
         while (infos.size() > 64) infos.erase(infos.begin());
       }
@@ -390,10 +403,105 @@ int main(int argc, char** argv) {
     fps_data = (sink.states.size() - 1) /
                std::max(1e-9, (sink.states.back().header.stamp - sink.states.front().header.stamp).toSec());
   }
-  // Landmark-centre jitter: C as the input shows it (real frame, normalized
-  // x width = px) vs the target H the output holds it at.
-  const double W = ws.pipeline_ready ? 1.0 : 1.0;
-  (void)W;
+  // Ground truth (simulator bags): the true head centre and far-background
+  // directions mapped through each frame's warp, as the scorecard does. The
+  // warp of a frame is K_out R_v R_r^-1 K_in^-1 (middle-row R_r; the rolling
+  // shutter's within-frame part is below a pixel here).
+  std::string truth_json;
+  if (a.truth.empty() && std::ifstream(a.in + ".truth.csv").good()) a.truth = a.in + ".truth.csv";
+  if (!a.truth.empty() && !sink.states.empty() && have_in_info) {
+    std::ifstream tf(a.truth);
+    std::string line;
+    std::getline(tf, line);
+    struct T {
+      Eigen::Vector2d head;
+      bool in_view;
+      std::vector<Eigen::Quaterniond> rows;
+    };
+    std::map<int64_t, T> truth;  // by stamp in ms
+    while (std::getline(tf, line)) {
+      std::vector<double> v;
+      std::stringstream ss(line);
+      std::string cell;
+      while (std::getline(ss, cell, ',')) v.push_back(std::atof(cell.c_str()));
+      if (v.size() < 9 + 64) continue;
+      T t;
+      t.head = Eigen::Vector2d(v[2], v[3]);
+      t.in_view = v[4] != 0;
+      for (int r = 0; r < 16; ++r) {
+        t.rows.emplace_back(v[9 + 4 * r + 3], v[9 + 4 * r], v[9 + 4 * r + 1], v[9 + 4 * r + 2]);
+      }
+      truth[std::llround(v[1] * 1000.0)] = t;
+    }
+    const Eigen::Matrix3d K_in = (Eigen::Matrix3d() << in_info.K[0], 0, in_info.K[2], 0,
+                                  in_info.K[4], in_info.K[5], 0, 0, 1).finished();
+    std::vector<Eigen::Vector2d> h_in, h_out, b_in, b_out;
+    Eigen::Vector3d dir = Eigen::Vector3d::Zero();
+    std::ofstream traj_none, traj_method;
+    if (!a.plot_dir.empty()) {
+      const std::string head = "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
+                               "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
+      traj_method.open(a.plot_dir + "/traj_" + a.plot_name + "_" +
+                       (a.gyro_only ? "gyro-only" : "steadiface") + ".csv");
+      traj_method << head;
+      if (!a.gyro_only) {
+        traj_none.open(a.plot_dir + "/traj_" + a.plot_name + "_none.csv");
+        traj_none << head;
+      }
+    }
+    const double t0 = sink.states.front().header.stamp.toSec();
+    for (size_t i = 0; i < sink.states.size() && i < sink.infos_out.size(); ++i) {
+      const auto& s = sink.states[i];
+      auto it = truth.find(std::llround(s.header.stamp.toSec() * 1000.0));
+      if (it == truth.end()) continue;
+      const T& t = it->second;
+      Eigen::Quaterniond Rv, Rr;
+      steadiface_ros::ToEigen(s.virtual_rotation, &Rv);
+      steadiface_ros::ToEigen(s.real_rotation, &Rr);
+      const auto& ko = sink.infos_out[i].K;
+      const Eigen::Matrix3d K_out = (Eigen::Matrix3d() << ko[0], 0, ko[2], 0, ko[4], ko[5], 0, 0, 1).finished();
+      const Eigen::Matrix3d H = K_out * (Rv * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
+      // A far-background direction fixed in the world: the first frame's
+      // view centre, seen in each frame through the true middle-row rotation.
+      const Eigen::Quaterniond R_true = t.rows[7];
+      if (dir.isZero()) dir = R_true.conjugate() * Eigen::Vector3d(0.05, 0.03, 1.0);
+      const Eigen::Vector3d c = R_true * dir;
+      const Eigen::Vector2d bin = (K_in * c).hnormalized();
+      const Eigen::Vector2d bout = (H * bin.homogeneous()).hnormalized();
+      b_in.push_back(bin);
+      b_out.push_back(bout);
+      Eigen::Vector2d hout = Eigen::Vector2d::Constant(NAN);
+      if (t.in_view) {
+        hout = (H * t.head.homogeneous()).hnormalized();
+        h_in.push_back(t.head);
+        h_out.push_back(hout);
+      }
+      const Eigen::Vector3d vr = steadiface::LogSO3(Rv), rr = steadiface::LogSO3(Rr);
+      auto row = [&](std::ofstream& f, const Eigen::Vector2d& ho, const Eigen::Vector2d& bo,
+                     const Eigen::Vector3d& v, const Eigen::Vector3d& r, double tx, double ty) {
+        if (!f.is_open()) return;
+        f << s.header.stamp.toSec() - t0 << "," << t.head.x() << "," << t.head.y() << "," << ho.x()
+          << "," << ho.y() << "," << t.in_view << "," << bo.x() << "," << bo.y() << "," << v.x()
+          << "," << v.y() << "," << v.z() << "," << r.x() << "," << r.y() << "," << r.z() << ","
+          << tx << "," << ty << "\n";
+      };
+      row(traj_method, hout, bout, vr, rr, s.principal_offset[0], s.principal_offset[1]);
+      row(traj_none, t.in_view ? t.head : Eigen::Vector2d::Constant(NAN), bin, rr, rr, 0.0, 0.0);
+    }
+    const double diag = std::hypot(in_info.width, in_info.height);
+    std::ostringstream tj;
+    tj << ",\n  \"ground_truth\": {\"truth\": \"" << a.truth << "\""
+       << ", \"head_jitter_in_px\": " << HighPassRms(h_in, fps_data, 0.5)
+       << ", \"head_jitter_out_px\": " << HighPassRms(h_out, fps_data, 0.5)
+       << ", \"head_jitter_out_frac\": " << HighPassRms(h_out, fps_data, 0.5) / diag
+       << ", \"background_jitter_in_px\": " << HighPassRms(b_in, fps_data, 0.5)
+       << ", \"background_jitter_out_px\": " << HighPassRms(b_out, fps_data, 0.5)
+       << ", \"cropping\": " << std::pow(1.0 - 2.0 * po.warp.output.crop_ratio, 2.0)
+       << ", \"undefined_fraction\": "
+       << static_cast<double>(ws.stabilizer.undefined_frames) / std::max<size_t>(1, sink.states.size())
+       << "}";
+    truth_json = tj.str();
+  }
   std::ostringstream rep;
   rep.precision(6);
   rep << "{\n  \"input\": \"" << a.in << "\",\n  \"frames_in\": " << ws.counters.images_in
@@ -423,7 +531,8 @@ int main(int argc, char** argv) {
       << "\"solver\": [" << Percentile(solver_ms, 0.5) << ", " << Percentile(solver_ms, 0.99) << "], "
       << "\"warp\": [" << Percentile(warp_ms, 0.5) << ", " << Percentile(warp_ms, 0.99) << "], "
       << "\"total\": [" << Percentile(total_ms, 0.5) << ", " << Percentile(total_ms, 0.99) << "]}"
-      << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5) << "\n}\n";
+      << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5) << truth_json
+      << ",\n  \"method\": \"" << (a.gyro_only ? "gyro-only" : "steadiface") << "\"\n}\n";
   if (!a.report.empty()) {
     std::ofstream f(a.report + ".part");
     f << rep.str();

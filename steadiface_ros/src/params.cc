@@ -33,8 +33,8 @@ class YamlParamSource : public ParamSource {
   bool GetT(const std::string& key, T* v) const {
     // Later documents override earlier ones.
     for (auto it = docs_.rbegin(); it != docs_.rend(); ++it) {
-      YAML::Node n = Lookup(*it, key);
-      if (!n) continue;
+      YAML::Node n;
+      if (!Lookup(*it, key, &n) || n.IsNull()) continue;
       try {
         *v = n.as<T>();
         return true;
@@ -51,15 +51,22 @@ class YamlParamSource : public ParamSource {
   bool Get(const std::string& k, std::vector<double>* v) const override { return GetT(k, v); }
 
  private:
-  static YAML::Node Lookup(const YAML::Node& root, const std::string& key) {
-    YAML::Node n = YAML::Clone(root);
+  // Walks '/'-separated `key` through nested maps without modifying them.
+  static bool Lookup(const YAML::Node& root, const std::string& key, YAML::Node* out) {
+    const YAML::Node* cur = &root;
+    YAML::Node holder;
     std::stringstream ss(key);
     std::string part;
     while (std::getline(ss, part, '/')) {
-      if (!n.IsMap() || !n[part]) return YAML::Node();
-      n = n[part];
+      if (!cur->IsMap()) return false;
+      const YAML::Node& c = *cur;
+      const YAML::Node child = c[part];  // const operator[]: no insertion
+      if (!child.IsDefined()) return false;
+      holder.reset(child);
+      cur = &holder;
     }
-    return n;
+    *out = *cur;
+    return true;
   }
   std::vector<YAML::Node> docs_;
 };

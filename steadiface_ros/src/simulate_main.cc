@@ -77,6 +77,7 @@ int main(int argc, char** argv) {
   rosbag::Bag bag;
   try {
     bag.open(tmp, rosbag::bagmode::Write);
+    bag.setCompression(rosbag::compression::LZ4);
   } catch (const rosbag::BagException& e) {
     std::cerr << "steadiface_simulate: cannot write " << tmp << ": " << e.what() << "\n";
     return 1;
