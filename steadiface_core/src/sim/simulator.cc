@@ -200,9 +200,7 @@ Status Simulator::Init() {
       g.angular_velocity *= o.real_gyro_scale;
       real_gyro_->AddSample(g);
     }
-    if (ToSeconds(real_gyro_->newest()) < o.duration_s + o.readout_s + 0.06) {
-      return Status::Error("sim: the real gyro trace is shorter than the sequence");
-    }
+    real_gyro_span_s_ = ToSeconds(real_gyro_->newest()) - 0.01;
   }
   // IMU.
   std::mt19937_64 rng(options_.seed * 104729 + 3);
@@ -214,7 +212,9 @@ Status Simulator::Init() {
     const double t = i / o.imu_rate_hz;
     Eigen::Vector3d w;
     if (real_gyro_) {
-      real_gyro_->AngularVelocity(Time(FromSeconds(t)), &w);
+      double sign = 1.0;
+      real_gyro_->AngularVelocity(Time(FromSeconds(RealGyroTime(t, &sign))), &w);
+      w *= sign;
     } else {
       w = camera_.AngularVelocity(t);
     }
@@ -233,6 +233,19 @@ Eigen::Vector3d Simulator::Body(double t) const {
                          options_.body_bob_m * std::sin(w * t), 0.0);
 }
 
+double Simulator::RealGyroTime(double t, double* sign) const {
+  // Longer sequences play the trace forwards, then backwards (a smooth,
+  // continuous orientation path; angular velocity flips sign).
+  const double T = real_gyro_span_s_;
+  double u = std::fmod(std::max(0.0, t), 2.0 * T);
+  *sign = 1.0;
+  if (u > T) {
+    u = 2.0 * T - u;
+    *sign = -1.0;
+  }
+  return u;
+}
+
 Pose Simulator::Orbit(const Pose& P, double t) const {
   if (!options_.pan_orbits_head || options_.camera.pan_rate == 0.0) return P;
   const Eigen::Quaterniond R_pan(
@@ -247,7 +260,8 @@ Pose Simulator::Orbit(const Pose& P, double t) const {
 Pose Simulator::CameraPose(double t) const {
   Pose C;
   if (real_gyro_) {
-    real_gyro_->CameraToWorld(Time(FromSeconds(t)), &C.R);
+    double sign = 1.0;
+    real_gyro_->CameraToWorld(Time(FromSeconds(RealGyroTime(t, &sign))), &C.R);
   } else {
     C.R = camera_.Orientation(t);  // includes the pan
   }

@@ -43,7 +43,8 @@ struct SimulatorOptions {
   /// Camera motion: parametric (pan + band-limited shake + translation) ...
   CameraMotionOptions camera;
   /// ... or the real recorded gyro trace (data_dir/gyro), scaled by
-  /// real_gyro_scale, replacing the parametric rotation.
+  /// real_gyro_scale, replacing the parametric rotation. Sequences longer
+  /// than the 9.9 s trace play it forwards, then backwards.
   bool use_real_gyro = false;
   /// The pan turns the person too: camera and head orbit the head's base
   /// position together (a vlogger turning with the phone at arm's length),
@@ -138,6 +139,9 @@ class Simulator {
   CameraMotion camera_;
   HeadMotion head_;
   std::unique_ptr<OrientationTimeline> real_gyro_;  // when use_real_gyro
+  double real_gyro_span_s_ = 0.0;
+  /// Time in the real trace for sequence time t (mirrored past its end).
+  double RealGyroTime(double t, double* sign) const;
   std::unique_ptr<InfiniteBackground> background_;
   Billboard face_, second_face_, occluder_;
   Eigen::Vector2d face_centre_uv_ = Eigen::Vector2d::Zero();

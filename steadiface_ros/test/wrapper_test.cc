@@ -1,0 +1,356 @@
+// StabilizerWrapper under bad input, faults and time jumps, with no ROS
+// master: simulated frames and IMU as messages, a recording sink.
+#include "steadiface_ros/stabilizer_wrapper.h"
+
+#include <cmath>
+#include <limits>
+
+#include <cv_bridge/cv_bridge.h>
+#include <gtest/gtest.h>
+#include <sensor_msgs/image_encodings.h>
+
+#include "steadiface_core/sim/simulator.h"
+#include "steadiface_ros/time_conversion.h"
+
+namespace steadiface_ros {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Sink : public OutputSink {
+  std::vector<sensor_msgs::ImagePtr> images;
+  std::vector<sensor_msgs::CameraInfoPtr> infos;
+  std::vector<steadiface::StabilizerState> states;
+  std::vector<steadiface::FaceLandmarks> landmarks;
+  std::vector<geometry_msgs::TransformStamped> tf;
+  std::map<std::string, int> warnings, errors;
+  void PublishImage(const sensor_msgs::ImagePtr& i, const sensor_msgs::CameraInfoPtr& c) override {
+    images.push_back(i);
+    infos.push_back(c);
+  }
+  void PublishLandmarks(const steadiface::FaceLandmarks& m) override { landmarks.push_back(m); }
+  void PublishState(const steadiface::StabilizerState& m) override { states.push_back(m); }
+  void PublishTf(const std::vector<geometry_msgs::TransformStamped>& t) override {
+    tf.insert(tf.end(), t.begin(), t.end());
+  }
+  bool WantsDebugImage() const override { return false; }
+  void PublishDebugImage(const sensor_msgs::ImagePtr&) override {}
+  void Warn(const std::string& k, const std::string&) override { ++warnings[k]; }
+  void Error(const std::string& k, const std::string&) override { ++errors[k]; }
+};
+
+// A short simulated stream as messages.
+struct Stream {
+  std::vector<sensor_msgs::Imu> imu;
+  std::vector<sensor_msgs::ImagePtr> images;
+  sensor_msgs::CameraInfoPtr info;
+  double readout = 0.0;
+};
+
+const Stream& TestStream() {
+  static const Stream s = [] {
+    Stream st;
+    steadiface::sim::SimulatorOptions o;
+    o.data_dir = STEADIFACE_TEST_DATA_DIR;
+    steadiface::sim::ApplyPreset("walk", &o);
+    o.width = 320;
+    o.height = 180;
+    o.duration_s = 2.0;
+    std::unique_ptr<steadiface::sim::Simulator> sim;
+    EXPECT_TRUE(steadiface::sim::Simulator::Create(o, &sim).ok());
+    st.readout = o.readout_s;
+    const ros::Duration shift(1000.0);
+    for (const auto& g : sim->imu()) {
+      sensor_msgs::Imu m;
+      m.header.stamp = ToRosTime(g.stamp) + shift;
+      m.header.frame_id = "cam";
+      m.angular_velocity.x = g.angular_velocity.x();
+      m.angular_velocity.y = g.angular_velocity.y();
+      m.angular_velocity.z = g.angular_velocity.z();
+      st.imu.push_back(m);
+    }
+    const steadiface::CameraIntrinsics& k = sim->intrinsics();
+    st.info.reset(new sensor_msgs::CameraInfo);
+    st.info->width = k.width;
+    st.info->height = k.height;
+    st.info->K = {k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1};
+    st.info->header.frame_id = "cam";
+    for (int i = 0; i < sim->num_frames(); ++i) {
+      cv::Mat f;
+      steadiface::sim::SimTruth t;
+      sim->Render(i, &f, &t);
+      std_msgs::Header h;
+      h.stamp = ToRosTime(t.stamp) + shift;
+      h.frame_id = "cam";
+      st.images.push_back(cv_bridge::CvImage(h, "bgr8", f).toImageMsg());
+    }
+    return st;
+  }();
+  return s;
+}
+
+steadiface::PipelineOptions Options() {
+  steadiface::PipelineOptions o;
+  o.shutter.readout_time_s = TestStream().readout;
+  o.landmark_source = steadiface::LandmarkSource::kNone;  // fast; faces are tested elsewhere
+  return o;
+}
+
+// Feeds the stream in time order (IMU up to each frame's last row first).
+void Feed(StabilizerWrapper* w, const Stream& s, int from = 0, int to = -1,
+          const std::function<void(sensor_msgs::Imu*)>& imu_fault = {},
+          const std::function<sensor_msgs::ImagePtr(int)>& image_fault = {}) {
+  if (to < 0) to = static_cast<int>(s.images.size());
+  size_t g = 0;
+  const ros::Time first = s.images[from]->header.stamp;
+  while (g < s.imu.size() && s.imu[g].header.stamp < first - ros::Duration(0.2)) ++g;
+  for (int i = from; i < to; ++i) {
+    const ros::Time last_row = s.images[i]->header.stamp + ros::Duration(s.readout + 0.006);
+    while (g < s.imu.size() && s.imu[g].header.stamp <= last_row) {
+      sensor_msgs::Imu m = s.imu[g++];
+      if (imu_fault) imu_fault(&m);
+      w->OnImu(m);
+    }
+    sensor_msgs::ImagePtr img = image_fault ? image_fault(i) : s.images[i];
+    if (!img) continue;
+    w->OnImage(img, s.info, img->header.stamp);
+    w->OnTimer(img->header.stamp);
+  }
+  w->Flush();
+}
+
+void ExpectAllFinite(const Sink& sink) {
+  for (const auto& s : sink.states) {
+    for (double v : {s.virtual_rotation.x, s.virtual_rotation.y, s.virtual_rotation.z,
+                     s.virtual_rotation.w, s.principal_offset[0], s.principal_offset[1],
+                     s.energy_fit, s.w_fit, s.total_ms}) {
+      ASSERT_TRUE(std::isfinite(v));
+    }
+  }
+  for (const auto& t : sink.tf) {
+    const auto& q = t.transform.rotation;
+    ASSERT_TRUE(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w));
+  }
+  for (const auto& c : sink.infos) {
+    for (double v : c->K) ASSERT_TRUE(std::isfinite(v));
+  }
+}
+
+TEST(WrapperTest, CleanStreamIsStabilizedFrameByFrame) {
+  Sink sink;
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  Feed(&w, TestStream());
+  EXPECT_EQ(sink.states.size(), TestStream().images.size());
+  EXPECT_EQ(sink.images.size(), TestStream().images.size());
+  EXPECT_EQ(w.Status().counters.extrapolated, 0u);
+  ExpectAllFinite(sink);
+  std::vector<ros::Time> stamps;
+  for (const auto& t : sink.tf) {
+    if (t.child_frame_id == "cam_stabilized") stamps.push_back(t.header.stamp);
+  }
+  ASSERT_EQ(stamps.size(), TestStream().images.size());
+  for (size_t i = 1; i < stamps.size(); ++i) EXPECT_GT(stamps[i], stamps[i - 1]);
+}
+
+TEST(WrapperTest, ImuFaultsAreRejectedCountedAndHarmless) {
+  Sink sink;
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  int k = 0;
+  Feed(&w, TestStream(), 0, -1, [&](sensor_msgs::Imu* m) {
+    ++k;
+    if (k % 17 == 0) m->angular_velocity.x = kNaN;                  // NaN
+    if (k % 23 == 0) m->angular_velocity.y = INFINITY;              // Inf
+    if (k % 29 == 0) m->header.stamp -= ros::Duration(0.0001);     // out of order
+    if (k % 31 == 0) m->angular_velocity.z = 1e4;                   // implausible
+  });
+  const WrapperStatus s = w.Status();
+  EXPECT_GT(s.counters.imu_rejected, 20u);
+  EXPECT_GT(s.timeline.count(steadiface::SampleResult::kNonFinite), 10u);
+  EXPECT_GT(s.timeline.count(steadiface::SampleResult::kImplausibleRate), 3u);
+  EXPECT_EQ(sink.states.size(), TestStream().images.size());
+  ExpectAllFinite(sink);
+  EXPECT_GT(sink.warnings["imu_non_finite"], 0);
+}
+
+TEST(WrapperTest, ImuGapIsWarnedAndFramesExtrapolatedOrDropped) {
+  for (LateFramePolicy policy : {LateFramePolicy::kExtrapolate, LateFramePolicy::kDrop}) {
+    Sink sink;
+    WrapperOptions wo;
+    wo.late_frame_policy = policy;
+    steadiface::PipelineOptions po = Options();
+    po.imu.max_extrapolation_s = 0.05;
+    StabilizerWrapper w(po, wo, &sink);
+    const Stream& st = TestStream();
+    const ros::Time gap_from = st.images[20]->header.stamp, gap_to = st.images[24]->header.stamp;
+    Feed(&w, st, 0, -1, [&](sensor_msgs::Imu* m) {
+      if (m->header.stamp > gap_from && m->header.stamp < gap_to) m->angular_velocity.x = kNaN;
+    });
+    const WrapperStatus s = w.Status();
+    EXPECT_GT(s.counters.imu_gaps, 0u);
+    if (policy == LateFramePolicy::kExtrapolate) {
+      EXPECT_GT(s.counters.extrapolated + s.counters.dropped_no_gyro, 0u);
+    } else {
+      EXPECT_GT(s.counters.dropped_no_gyro, 0u);
+      EXPECT_EQ(s.counters.extrapolated, 0u);
+    }
+    ExpectAllFinite(sink);
+    // Stabilization resumes after the gap.
+    EXPECT_GT(sink.states.size(), st.images.size() - 6);
+  }
+}
+
+TEST(WrapperTest, NoImuPassesFramesThroughUnstabilized) {
+  Sink sink;
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  const Stream& st = TestStream();
+  for (const auto& img : st.images) {
+    w.OnImage(img, st.info, img->header.stamp);
+    w.OnTimer(img->header.stamp + ros::Duration(0.2));
+  }
+  w.Flush();
+  EXPECT_EQ(sink.images.size(), st.images.size());
+  EXPECT_TRUE(sink.states.empty());
+  EXPECT_EQ(w.Status().counters.passthrough, st.images.size());
+  EXPECT_GT(sink.errors["no_imu"], 0);
+  // Or dropped, when configured so.
+  Sink sink2;
+  WrapperOptions wo;
+  wo.passthrough_without_imu = false;
+  StabilizerWrapper w2(Options(), wo, &sink2);
+  for (const auto& img : st.images) w2.OnImage(img, st.info, img->header.stamp);
+  w2.Flush();
+  EXPECT_TRUE(sink2.images.empty());
+  EXPECT_EQ(w2.Status().counters.dropped_no_gyro, st.images.size());
+}
+
+sensor_msgs::ImagePtr Copy(const sensor_msgs::ImagePtr& m) {
+  return sensor_msgs::ImagePtr(new sensor_msgs::Image(*m));
+}
+
+TEST(WrapperTest, BadImagesAreDroppedWithAReason) {
+  Sink sink;
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  const Stream& st = TestStream();
+  Feed(&w, st, 0, -1, {}, [&](int i) -> sensor_msgs::ImagePtr {
+    sensor_msgs::ImagePtr m = Copy(st.images[i]);
+    switch (i) {
+      case 5: m->encoding = "no_such_encoding"; break;
+      case 6: m->width = m->height = 0; m->data.clear(); break;
+      case 7: m->data.resize(m->data.size() / 2); break;           // step * height != size
+      case 8: m->step = 10; break;                                 // step < width * 3
+      case 9: m->width = 100; m->step = 300; m->data.resize(300 * m->height); break;  // != camera_info
+      case 10: m->encoding = "mono16"; m->step = m->width * 2;
+               m->data.assign(m->step * m->height, 0x40); break;   // converted by cv_bridge
+      case 11: m->encoding = "32FC1"; m->step = m->width * 4;
+               m->data.assign(m->step * m->height, 0); break;      // not cleanly: refused
+      default: break;
+    }
+    return m;
+  });
+  const WrapperStatus s = w.Status();
+  EXPECT_EQ(s.counters.dropped_bad_image, 6u);  // 5, 6, 7, 8, 9, 11
+  EXPECT_EQ(sink.states.size(), st.images.size() - 6);
+  EXPECT_GT(sink.errors["image"], 0);
+  EXPECT_GT(sink.errors["image_size"], 0);
+  ExpectAllFinite(sink);
+}
+
+TEST(WrapperTest, CameraInfoMissingOrChangingIsHandled) {
+  Sink sink;
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  const Stream& st = TestStream();
+  size_t g = 0;
+  sensor_msgs::CameraInfoPtr uncal(new sensor_msgs::CameraInfo(*st.info));
+  uncal->K.fill(0.0);
+  for (size_t i = 0; i < st.images.size(); ++i) {
+    while (g < st.imu.size() && st.imu[g].header.stamp <= st.images[i]->header.stamp + ros::Duration(0.03)) {
+      w.OnImu(st.imu[g++]);
+    }
+    if (i == 3) {
+      w.OnImage(st.images[i], nullptr, st.images[i]->header.stamp);  // no camera_info
+    } else if (i == 4) {
+      w.OnImage(st.images[i], uncal, st.images[i]->header.stamp);    // uncalibrated
+    } else if (i >= 30) {
+      // Resolution change mid-stream: half-size frames with matching info.
+      sensor_msgs::CameraInfoPtr half(new sensor_msgs::CameraInfo(*st.info));
+      half->width /= 2;
+      half->height /= 2;
+      for (int k : {0, 2, 4, 5}) half->K[k] /= 2;
+      cv::Mat small;
+      cv::resize(cv_bridge::toCvShare(st.images[i])->image, small, cv::Size(half->width, half->height));
+      sensor_msgs::ImagePtr m = cv_bridge::CvImage(st.images[i]->header, "bgr8", small).toImageMsg();
+      w.OnImage(m, half, m->header.stamp);
+    } else {
+      w.OnImage(st.images[i], st.info, st.images[i]->header.stamp);
+    }
+    w.OnTimer(st.images[i]->header.stamp);
+  }
+  w.Flush();
+  const WrapperStatus s = w.Status();
+  EXPECT_EQ(s.counters.dropped_bad_info, 2u);
+  EXPECT_EQ(s.counters.rebuilds, 1u);
+  EXPECT_EQ(sink.images.back()->width, st.info->width / 2);
+  EXPECT_EQ(sink.infos.back()->width, st.info->width / 2);
+  EXPECT_EQ(sink.states.size(), st.images.size() - 2);
+  ExpectAllFinite(sink);
+}
+
+TEST(WrapperTest, BurstsBeyondTheQueueAreBoundedAndCounted) {
+  Sink sink;
+  WrapperOptions wo;
+  wo.frame_queue_size = 5;
+  StabilizerWrapper w(Options(), wo, &sink);
+  const Stream& st = TestStream();
+  // A burst of 30 frames before any IMU arrives, and no time passing.
+  for (int i = 0; i < 30; ++i) w.OnImage(st.images[i], st.info, ros::Time(1.0));
+  EXPECT_EQ(w.Status().counters.dropped_queue_full, 25u);
+  for (const auto& m : st.imu) w.OnImu(m);
+  w.Flush();
+  EXPECT_EQ(sink.states.size(), 5u);
+}
+
+TEST(WrapperTest, TimeJumpBackResetsAndTheSecondPassMatchesTheFirst) {
+  // A `rosbag play --loop` restart: the same stream twice.
+  Sink sink;
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  const Stream& st = TestStream();
+  Feed(&w, st);
+  const size_t n = sink.states.size();
+  Feed(&w, st);
+  ASSERT_EQ(sink.states.size(), 2 * n);
+  EXPECT_EQ(w.Status().counters.time_jumps, 1u);
+  for (size_t i = 0; i < n; ++i) {
+    const auto& a = sink.states[i];
+    const auto& b = sink.states[n + i];
+    EXPECT_EQ(a.header.stamp, b.header.stamp);
+    EXPECT_NEAR(a.virtual_rotation.x, b.virtual_rotation.x, 1e-12);
+    EXPECT_NEAR(a.virtual_rotation.w, b.virtual_rotation.w, 1e-12);
+    EXPECT_NEAR(a.principal_offset[0], b.principal_offset[0], 1e-12);
+  }
+  // TF strictly increasing within each epoch.
+  std::vector<ros::Time> stamps;
+  for (const auto& t : sink.tf) {
+    if (t.child_frame_id == "cam_stabilized") stamps.push_back(t.header.stamp);
+  }
+  int decreases = 0;
+  for (size_t i = 1; i < stamps.size(); ++i) {
+    if (stamps[i] <= stamps[i - 1]) ++decreases;
+  }
+  EXPECT_EQ(decreases, 1);  // exactly at the epoch change
+}
+
+TEST(WrapperTest, ReconfigureRequestsApplyOnTheNextFrame) {
+  Sink sink;
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  const Stream& st = TestStream();
+  Feed(&w, st, 0, 10);
+  steadiface::StabilizerOptions o = w.pipeline_options().stabilizer;
+  o.weights.distortion = 7.5;
+  w.RequestStabilizerOptions(o);
+  Feed(&w, st, 10, 12);
+  EXPECT_EQ(sink.states[9].w_distortion, 200.0);
+  EXPECT_EQ(sink.states[10].w_distortion, 7.5);
+}
+
+}  // namespace
+}  // namespace steadiface_ros
