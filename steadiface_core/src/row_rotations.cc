@@ -43,6 +43,7 @@ RowRotations RowRotations::FromTable(std::vector<Eigen::Quaterniond> table,
 Eigen::Quaterniond RowRotations::At(double y) const {
   if (table_.size() == 1) return table_[0];
   const double n1 = static_cast<double>(table_.size() - 1);
+  if (!std::isfinite(y)) y = 0.5 * (height_ - 1);  // found by fuzz_imu
   double s = height_ > 1 ? y / (height_ - 1) * n1 : 0.0;
   s = std::min(std::max(s, 0.0), n1);
   const size_t i = std::min(static_cast<size_t>(s), table_.size() - 2);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "steadiface_core/row_rotations.h"
 #include "steadiface_core/so3.h"
 
 namespace steadiface {
@@ -59,6 +60,17 @@ TEST(RowTimingTest, PerRowRealRotation) {
   const Eigen::Quaterniond rel = top * bottom.conjugate();
   EXPECT_NEAR(AngleBetween(rel, ExpSO3(w * 0.02)), 0.0, 1e-12);
   EXPECT_NEAR(AngleBetween(mid, ExpSO3(w * 0.5).conjugate()), 0.0, 1e-12);
+}
+
+TEST(RowTimingTest, NonFiniteRowGivesTheMiddleRow) {
+  // Found by fuzz_imu: a NaN row was cast to an index.
+  const RowRotations rows = RowRotations::FromTable(
+      {ExpSO3(Eigen::Vector3d(0.1, 0, 0)), ExpSO3(Eigen::Vector3d(0.2, 0, 0)),
+       ExpSO3(Eigen::Vector3d(0.3, 0, 0))},
+      101);
+  EXPECT_NEAR(AngleBetween(rows.At(NAN), rows.At(50.0)), 0.0, 1e-12);
+  EXPECT_NEAR(AngleBetween(rows.At(INFINITY), rows.At(50.0)), 0.0, 1e-12);
+  EXPECT_NEAR(AngleBetween(rows.At(-5.0), rows.At(0.0)), 0.0, 1e-12);
 }
 
 TEST(RowTimingTest, Validation) {

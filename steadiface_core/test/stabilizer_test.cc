@@ -563,6 +563,12 @@ TEST(StabilizerTest, RejectsBadOptionsAndStamps) {
   bad.centre = Eigen::Vector2d(0.5, 0.5);
   EXPECT_TRUE(stab->Process(Time(FromSeconds(1.0)), tl, timing, &bad, &f).ok());
   EXPECT_FALSE(f.has_target);
+  // ... and so is one with a NaN landmark row.
+  bad.landmarks = {Eigen::Vector2d(0.5, 0.5)};
+  bad.landmark_rows = {NAN};
+  EXPECT_TRUE(stab->Process(Time(FromSeconds(1.1)), tl, timing, &bad, &f).ok());
+  EXPECT_FALSE(f.has_target);
+  EXPECT_TRUE(f.R_v.coeffs().allFinite());
   EXPECT_TRUE(f.R_v.coeffs().allFinite());
 }
 

@@ -27,7 +27,7 @@ namespace {
 int Usage() {
   std::cerr << "usage: steadiface_simulate --preset NAME --out FILE.bag [--duration S]\n"
                "  [--size WxH] [--fps F] [--imu-rate HZ] [--seed N] [--mono] [--data DIR]\n"
-               "  [--clock-offset S] [--readout S] [--epoch S]\n"
+               "  [--clock-offset S] [--readout S] [--epoch S] [--no-face]\n"
                "presets: still walk pan run occlusion two_faces turn_away\n";
   return 2;
 }
@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
     else if (a == "--imu-rate") o.imu_rate_hz = std::atof(next().c_str());
     else if (a == "--seed") o.seed = std::strtoull(next().c_str(), nullptr, 10);
     else if (a == "--mono") mono = true;
+    else if (a == "--no-face") o.render_face = false;
     else if (a == "--data") data = next();
     else if (a == "--clock-offset") o.imu_clock_offset_s = std::atof(next().c_str());
     else if (a == "--readout") readout = std::atof(next().c_str());
@@ -67,6 +68,9 @@ int main(int argc, char** argv) {
   steadiface::Status s = steadiface::sim::ApplyPreset(preset, &o);
   o.duration_s = duration;
   if (readout >= 0) o.readout_s = readout;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--no-face") o.render_face = false;  // presets keep it on
+  }
   std::unique_ptr<steadiface::sim::Simulator> sim;
   if (s.ok()) s = steadiface::sim::Simulator::Create(o, &sim);
   if (!s.ok()) {

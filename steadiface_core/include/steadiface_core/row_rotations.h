@@ -31,7 +31,8 @@ class RowRotations {
   static RowRotations FromTable(std::vector<Eigen::Quaterniond> table,
                                 int height);
 
-  /// R_r at (fractional) pixel row y, clamped to [0, H-1].
+  /// R_r at (fractional) pixel row y, clamped to [0, H-1]; a non-finite y
+  /// gives the middle row.
   Eigen::Quaterniond At(double y) const;
   /// R_r at the middle row.
   Eigen::Quaterniond Middle() const { return At(0.5 * (height_ - 1)); }

@@ -296,7 +296,7 @@ SimTruth Simulator::Truth(int i) const {
   const bool visible = ProjectRollingShutter(
       k, row_time, cam, [&](double t) { return face_.WorldPoint(face_centre_uv_, t); },
       &tr.head_px);
-  tr.head_in_view = visible && tr.head_px.x() >= 0 && tr.head_px.y() >= 0 &&
+  tr.head_in_view = options_.render_face && visible && tr.head_px.x() >= 0 && tr.head_px.y() >= 0 &&
                     tr.head_px.x() <= k.width - 1 && tr.head_px.y() <= k.height - 1;
   Eigen::Vector2d a, b;
   const double half = 0.5 * options_.face_width_px;
@@ -325,7 +325,7 @@ Status Simulator::Render(int i, cv::Mat* bgr, SimTruth* truth) const {
   const double t = ToSeconds(stamp);
   std::vector<const Billboard*> boards;
   if (Active(t, options_.second_face_start_s, -1)) boards.push_back(&second_face_);
-  boards.push_back(&face_);
+  if (options_.render_face) boards.push_back(&face_);
   if (Active(t, options_.occlusion_start_s, options_.occlusion_end_s)) {
     boards.push_back(&occluder_);
   }

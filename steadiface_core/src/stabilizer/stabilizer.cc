@@ -40,6 +40,9 @@ bool FaceUsable(const FaceObservation* face, const StabilizerOptions& o) {
       face->landmark_rows.size() != face->landmarks.size()) {
     return false;
   }
+  for (double y : face->landmark_rows) {
+    if (!std::isfinite(y)) return false;
+  }
   return true;
 }
 

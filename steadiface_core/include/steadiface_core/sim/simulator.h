@@ -55,6 +55,8 @@ struct SimulatorOptions {
   /// by camera and head [m, Hz].
   HeadMotionOptions head;
   double body_bob_m = 0.02, body_sway_m = 0.01, body_bob_hz = 1.8;
+  /// Render the face at all (false: background only, e.g. a robot camera).
+  bool render_face = true;
   /// Face width on the billboard [m].
   double face_width_m = 0.15;
   /// IMU: gyro rate [Hz], white noise [rad/s], constant bias [rad/s],
