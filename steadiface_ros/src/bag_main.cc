@@ -41,6 +41,7 @@ struct Args {
   std::string image_topic = "camera/image_raw", info_topic = "camera/camera_info",
               imu_topic = "imu", landmarks_topic;
   bool debug_overlay = false, gyro_only = false, quiet = false;
+  double start_stamp = 0.0;  // images before this stamp are skipped
 };
 
 int Usage() {
@@ -50,7 +51,8 @@ int Usage() {
          "  [--video OUT.mp4] [--debug-overlay] [--report OUT.json]\n"
          "  [--trajectory OUT.csv] [--gyro-only] [--quiet]\n"
          "  [--truth IN.bag.truth.csv (default: found beside the bag)]\n"
-         "  [--plots DIR --name NAME: trajectories for scripts/plot_report.py]\n";
+         "  [--plots DIR --name NAME: trajectories for scripts/plot_report.py]\n"
+         "  [--start-stamp S: skip images stamped before S (IMU is still read)]\n";
   return 2;
 }
 
@@ -162,6 +164,7 @@ int main(int argc, char** argv) {
     else if (s == "--gyro-only") a.gyro_only = true;
     else if (s == "--quiet") a.quiet = true;
     else if (s == "--truth") a.truth = next();
+    else if (s == "--start-stamp") a.start_stamp = std::atof(next().c_str());
     else if (s == "--plots") a.plot_dir = next();
     else if (s == "--name") a.plot_name = next();
     else return Usage();
@@ -309,6 +312,7 @@ int main(int argc, char** argv) {
       if (auto lm = m.instantiate<steadiface::FaceLandmarks>()) wrapper.OnLandmarks(*lm);
     } else if (topic == norm(a.image_topic)) {
       if (auto img = m.instantiate<sensor_msgs::Image>()) {
+        if (img->header.stamp.toSec() < a.start_stamp - 1e-6) continue;
         waiting.push_back(img);
         ++images_seen;
       }
@@ -541,7 +545,7 @@ int main(int argc, char** argv) {
   }
   if (!a.trajectory.empty()) {
     std::ofstream f(a.trajectory);
-    f.precision(12);
+    f.precision(17);
     f << "stamp,qx,qy,qz,qw,tx,ty,rqx,rqy,rqz,rqw,has_target,hx,hy,cx,cy,w_fit\n";
     for (const auto& s : sink.states) {
       f << s.header.stamp.toSec() << "," << s.virtual_rotation.x << "," << s.virtual_rotation.y

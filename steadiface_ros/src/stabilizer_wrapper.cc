@@ -29,7 +29,15 @@ StabilizerWrapper::StabilizerWrapper(const steadiface::PipelineOptions& pipeline
     : options_(pipeline),
       wrapper_options_(options),
       sink_(sink),
-      extrinsic_lookup_(std::move(extrinsic_lookup)) {}
+      extrinsic_lookup_(std::move(extrinsic_lookup)) {
+  // Load the ~100 MB landmark model now, not on the first frame (which
+  // would stall the image queue for a second).
+  if (options_.landmark_source != steadiface::LandmarkSource::kNone) {
+    const steadiface::Status s =
+        steadiface::LandmarkPredictor::Load(options_.face.landmark_model_path, &preloaded_model_);
+    if (!s.ok()) sink_->Error("landmark_model", s.message());
+  }
+}
 
 void StabilizerWrapper::RequestStabilizerOptions(const steadiface::StabilizerOptions& o) {
   std::lock_guard<std::mutex> lock(options_mutex_);

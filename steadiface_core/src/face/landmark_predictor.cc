@@ -1,6 +1,8 @@
 #include "steadiface_core/face/landmark_predictor.h"
 
 #include <fstream>
+#include <map>
+#include <mutex>
 
 #include <dlib/image_processing/shape_predictor.h>
 #include <dlib/opencv/cv_image.h>
@@ -20,7 +22,7 @@ struct LandmarkPredictor::Impl {
   unsigned long num_parts() const { return initial_shape.size() / 2; }
 };
 
-LandmarkPredictor::LandmarkPredictor() : impl_(new Impl) {}
+LandmarkPredictor::LandmarkPredictor() = default;
 LandmarkPredictor::~LandmarkPredictor() = default;
 
 Status LandmarkPredictor::Load(const std::string& path,
@@ -34,7 +36,22 @@ Status LandmarkPredictor::Load(const std::string& path,
                          hint);
   }
   probe.close();
+  static std::mutex cache_mutex;
+  static std::map<std::string, std::weak_ptr<const Impl>> cache;
+  {
+    std::lock_guard<std::mutex> lock(cache_mutex);
+    auto it = cache.find(path);
+    if (it != cache.end()) {
+      if (std::shared_ptr<const Impl> shared = it->second.lock()) {
+        std::unique_ptr<LandmarkPredictor> p(new LandmarkPredictor);
+        p->impl_ = shared;
+        *out = std::move(p);
+        return Status::Ok();
+      }
+    }
+  }
   std::unique_ptr<LandmarkPredictor> p(new LandmarkPredictor);
+  auto impl = std::make_shared<Impl>();
   try {
     std::ifstream in(path, std::ios::binary);
     int version = 0;
@@ -43,7 +60,7 @@ Status LandmarkPredictor::Load(const std::string& path,
       throw dlib::serialization_error("unexpected shape_predictor version " +
                                       std::to_string(version));
     }
-    Impl& m = *p->impl_;
+    Impl& m = *impl;
     dlib::deserialize(m.initial_shape, in);
     dlib::deserialize(m.forests, in);
     dlib::deserialize(m.anchor_idx, in);
@@ -57,10 +74,15 @@ Status LandmarkPredictor::Load(const std::string& path,
                          "' is not a valid dlib shape predictor (" + e.what() +
                          ")" + hint);
   }
-  if (p->impl_->num_parts() != 68) {
+  if (impl->num_parts() != 68) {
     return Status::Error("landmark model '" + path + "' predicts " +
-                         std::to_string(p->impl_->num_parts()) +
+                         std::to_string(impl->num_parts()) +
                          " points; steadiface needs the 68-point model" + hint);
+  }
+  p->impl_ = impl;
+  {
+    std::lock_guard<std::mutex> lock(cache_mutex);
+    cache[path] = impl;
   }
   *out = std::move(p);
   return Status::Ok();

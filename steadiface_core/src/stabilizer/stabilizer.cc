@@ -144,10 +144,13 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
           &mean_speed)) {
     mean_speed = -1.0;
   }
+  // A camera fixed in the world at the epoch's first real rotation: what
+  // it sees does not depend on where the gyro integration started.
+  if (history_ == 0) R_reference_ = f.R_r;
   Eigen::Vector2d stabilized_centre = Eigen::Vector2d::Zero();
   if (use_face) {
-    model_.Project(face->centre, Eigen::Quaterniond::Identity(),
-                   Eigen::Vector2d::Zero(), f.R_r, &stabilized_centre);
+    model_.Project(face->centre, R_reference_, Eigen::Vector2d::Zero(), f.R_r,
+                   &stabilized_centre);
   }
   f.factors =
       dynamic_.Update(dt, mean_speed, use_face ? face : nullptr,
@@ -182,8 +185,8 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
     for (size_t i = 0; i < held.landmarks.size() && ok; ++i) {
       const Eigen::Quaterniond R_row =
           held.landmark_rows.empty() ? f.R_r : f.rows.At(held.landmark_rows[i]);
-      ok = model_.Unproject(held_face_.landmarks[i], Eigen::Quaterniond::Identity(),
-                            Eigen::Vector2d::Zero(), R_row, &held.landmarks[i]);
+      ok = model_.Unproject(held_face_.landmarks[i], R_reference_, Eigen::Vector2d::Zero(),
+                            R_row, &held.landmarks[i]);
     }
     if (ok) {
       ComputeCentreAndScale(&held);
@@ -223,8 +226,8 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
       for (size_t i = 0; i < face->landmarks.size(); ++i) {
         const Eigen::Quaterniond R_row =
             face->landmark_rows.empty() ? f.R_r : f.rows.At(face->landmark_rows[i]);
-        model_.Project(face->landmarks[i], Eigen::Quaterniond::Identity(),
-                       Eigen::Vector2d::Zero(), R_row, &held_face_.landmarks[i]);
+        model_.Project(face->landmarks[i], R_reference_, Eigen::Vector2d::Zero(), R_row,
+                       &held_face_.landmarks[i]);
       }
       has_held_face_ = true;
     }

@@ -131,6 +131,8 @@ class StabilizerWrapper {
   ExtrinsicLookup extrinsic_lookup_;
 
   std::unique_ptr<steadiface::Pipeline> pipeline_;
+  // Keeps the landmark model loaded from start-up (shared with pipelines).
+  std::unique_ptr<steadiface::LandmarkPredictor> preloaded_model_;
   sensor_msgs::CameraInfo pipeline_info_;
   std::string imu_frame_;
   bool extrinsic_resolved_ = false;

@@ -21,7 +21,9 @@ class LandmarkPredictor {
  public:
   ~LandmarkPredictor();
   /// Loads the model; a missing or corrupt file gives an error naming the
-  /// file and the Debian package that ships it.
+  /// file and the Debian package that ships it. Models are shared: loading
+  /// a path that another live predictor already loaded is free (the ~100 MB
+  /// model takes ~1 s to read), so a node can load it at start-up.
   static Status Load(const std::string& path,
                      std::unique_ptr<LandmarkPredictor>* out);
 
@@ -38,7 +40,7 @@ class LandmarkPredictor {
  private:
   LandmarkPredictor();
   struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::shared_ptr<const Impl> impl_;
 };
 
 }  // namespace steadiface
