@@ -26,6 +26,7 @@
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "steadiface_core/eval/scorecard.h"
 #include "steadiface_core/so3.h"
 #include "steadiface_ros/msg_conversion.h"
 #include "steadiface_ros/params.h"
@@ -62,30 +63,9 @@ double Percentile(std::vector<double> v, double p) {
   return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
 }
 
-// High-pass (> cutoff) RMS of a series, linear trend removed (DFT).
+// The scorecard's definition of jitter: > cutoff RMS, linear trend removed.
 double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps, double cutoff) {
-  const int n = static_cast<int>(x.size());
-  if (n < 8) return 0.0;
-  double total = 0.0;
-  for (int axis = 0; axis < 2; ++axis) {
-    double st = 0, sx = 0, stt = 0, stx = 0;
-    for (int i = 0; i < n; ++i) {
-      st += i;
-      sx += x[i][axis];
-      stt += double(i) * i;
-      stx += i * x[i][axis];
-    }
-    const double b = (n * stx - st * sx) / (n * stt - st * st), a = (sx - b * st) / n;
-    cv::Mat in(1, n, CV_64F), spec, back;
-    for (int i = 0; i < n; ++i) in.at<double>(0, i) = x[i][axis] - (a + b * i);
-    cv::dft(in, spec, cv::DFT_COMPLEX_OUTPUT);
-    for (int k = 0; k < n; ++k) {
-      if (std::min(k, n - k) * fps / n < cutoff) spec.at<cv::Vec2d>(0, k) = cv::Vec2d(0, 0);
-    }
-    cv::dft(spec, back, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
-    for (int i = 0; i < n; ++i) total += back.at<double>(0, i) * back.at<double>(0, i);
-  }
-  return std::sqrt(total / n);
+  return steadiface::eval::Scorecard::HighPassRms(x, fps, cutoff);
 }
 
 // Collects everything the wrapper produces: to the output bag, the video

@@ -314,8 +314,20 @@ void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::StabilizerOp
   o->dynamic.gyro_active_rad_s = std::max(c.gyro_active, c.gyro_still + 1e-4);
   o->dynamic.pose_low_rad = c.pose_low;
   o->dynamic.pose_high_rad = std::max(c.pose_high, c.pose_low + 1e-3);
+  o->dynamic.gyro_window_s = c.gyro_window;
+  o->dynamic.gyro_still_fit_scale = c.gyro_still_fit_scale;
+  o->dynamic.pose_min_fit_scale = c.pose_min_fit_scale;
+  o->dynamic.pose_smoothness_boost = c.pose_smoothness_boost;
+  o->dynamic.centre_variation_low = c.centre_variation_low;
+  o->dynamic.centre_variation_high = std::max(c.centre_variation_high, c.centre_variation_low + 1e-6);
+  o->dynamic.scale_variation_low = c.scale_variation_low;
+  o->dynamic.scale_variation_high = std::max(c.scale_variation_high, c.scale_variation_low + 1e-6);
+  o->dynamic.variation_min_fit_scale = c.variation_min_fit_scale;
   o->gyro_only = c.gyro_only;
   o->min_face_confidence = c.min_face_confidence;
+  o->protrusion_search_steps = c.protrusion_search_steps;
+  o->solver.max_iterations = c.solver_max_iterations;
+  o->smooth_head_in_virtual_view = c.smooth_head_in_virtual_view;
 }
 
 steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptions& o) {
@@ -341,8 +353,20 @@ steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptio
   c.gyro_active = o.dynamic.gyro_active_rad_s;
   c.pose_low = o.dynamic.pose_low_rad;
   c.pose_high = o.dynamic.pose_high_rad;
+  c.gyro_window = o.dynamic.gyro_window_s;
+  c.gyro_still_fit_scale = o.dynamic.gyro_still_fit_scale;
+  c.pose_min_fit_scale = o.dynamic.pose_min_fit_scale;
+  c.pose_smoothness_boost = o.dynamic.pose_smoothness_boost;
+  c.centre_variation_low = o.dynamic.centre_variation_low;
+  c.centre_variation_high = o.dynamic.centre_variation_high;
+  c.scale_variation_low = o.dynamic.scale_variation_low;
+  c.scale_variation_high = o.dynamic.scale_variation_high;
+  c.variation_min_fit_scale = o.dynamic.variation_min_fit_scale;
   c.gyro_only = o.gyro_only;
   c.min_face_confidence = o.min_face_confidence;
+  c.protrusion_search_steps = o.protrusion_search_steps;
+  c.solver_max_iterations = o.solver.max_iterations;
+  c.smooth_head_in_virtual_view = o.smooth_head_in_virtual_view;
   return c;
 }
 

@@ -41,6 +41,7 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   debug_pub_ = it_->advertise("debug_image", 2);
   landmarks_pub_ = nh_.advertise<steadiface::FaceLandmarks>("face_landmarks", 10);
   state_pub_ = nh_.advertise<steadiface::StabilizerState>("state", 10);
+  head_target_pub_ = nh_.advertise<geometry_msgs::PointStamped>("head_target", 10);
 
   // Diagnostics.
   updater_.reset(new diagnostic_updater::Updater(nh_, pnh_, name_));
@@ -152,6 +153,9 @@ void StabilizerRos::PublishLandmarks(const steadiface::FaceLandmarks& msg) {
 void StabilizerRos::PublishState(const steadiface::StabilizerState& msg) { state_pub_.publish(msg); }
 void StabilizerRos::PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) {
   if (!tf.empty()) tf_broadcaster_.sendTransform(tf);
+}
+void StabilizerRos::PublishHeadTarget(const geometry_msgs::PointStamped& p) {
+  head_target_pub_.publish(p);
 }
 bool StabilizerRos::WantsDebugImage() const { return debug_pub_.getNumSubscribers() > 0; }
 void StabilizerRos::PublishDebugImage(const sensor_msgs::ImagePtr& image) {

@@ -343,6 +343,21 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
     } else {
       ++counters_.tf_skipped;
     }
+    if (frame.stabilizer.has_target) {
+      const double f_v = pipeline_->camera_model().virtual_focal();
+      const Eigen::Vector3d ray =
+          Eigen::Vector3d((frame.stabilizer.H.x() - 0.5 - frame.stabilizer.t.x()) / f_v,
+                          (frame.stabilizer.H.y() - 0.5 - frame.stabilizer.t.y()) / f_v, 1.0)
+              .normalized();
+      if (ray.allFinite()) {
+        geometry_msgs::PointStamped p;
+        p.header = out_header;
+        p.point.x = ray.x();
+        p.point.y = ray.y();
+        p.point.z = ray.z();
+        sink_->PublishHeadTarget(p);
+      }
+    }
     if (sink_->WantsDebugImage()) {
       cv::Mat dbg;
       steadiface::DrawDebugOverlay(input, pipeline_->camera_model(),

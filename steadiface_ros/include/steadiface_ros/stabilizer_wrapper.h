@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/PointStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/time.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -30,6 +31,9 @@ class OutputSink {
   virtual void PublishLandmarks(const steadiface::FaceLandmarks& msg) = 0;
   virtual void PublishState(const steadiface::StabilizerState& msg) = 0;
   virtual void PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) = 0;
+  /// The target head centre H as a 3D point 1 m along its ray, in the
+  /// stabilized camera's frame (for rviz).
+  virtual void PublishHeadTarget(const geometry_msgs::PointStamped& /*p*/) {}
   /// Debug images are rendered only when this returns true.
   virtual bool WantsDebugImage() const = 0;
   virtual void PublishDebugImage(const sensor_msgs::ImagePtr& image) = 0;
