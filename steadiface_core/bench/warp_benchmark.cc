@@ -29,7 +29,6 @@ struct Fixture {
     input.create(h, w, channels == 1 ? CV_8UC1 : CV_8UC3);
     cv::randu(input, cv::Scalar::all(0), cv::Scalar::all(255));
     // A rolling-shutter frame: 25 mrad of rotation over the readout.
-    const Eigen::Quaterniond top = ExpSO3(Eigen::Vector3d(0.01, 0.02, 0.0));
     OrientationTimeline tl{OrientationTimelineOptions()};
     for (int i = 0; i <= 100; ++i) {
       tl.AddSample({Time(FromSeconds(i * 0.001)), Eigen::Vector3d(0.3, 0.8, 0.1)});
@@ -38,7 +37,6 @@ struct Fixture {
     rs.readout_time_s = 0.03;
     RowRotations::Build(tl, RowTiming(rs, h), Time(FromSeconds(0.02)), 32, &rows);
     R_v = rows.Middle() * ExpSO3(Eigen::Vector3d(0.005, -0.01, 0.002));
-    (void)top;
   }
 };
 

@@ -372,15 +372,11 @@ int main(int argc, char** argv) {
     Eigen::Quaterniond q;
     steadiface_ros::ToEigen(s.virtual_rotation, &q);
     const Eigen::Vector3d v = steadiface::LogSO3(q);
-    Eigen::Quaterniond r;
-    steadiface_ros::ToEigen(s.real_rotation, &r);
-    const Eigen::Vector3d rv = steadiface::LogSO3(r);
     shake.emplace_back(v.x(), v.y());
     if (s.has_target) {
       c_in.emplace_back(s.centre_c[0], s.centre_c[1]);
       c_out.emplace_back(s.target_h[0], s.target_h[1]);
     }
-    (void)rv;
   }
   double fps_data = 30.0;
   if (sink.states.size() > 2) {
