@@ -91,16 +91,20 @@ int main(int argc, char** argv) {
   // IMU and frames interleaved in time order (as a recording would be).
   const auto& imu = sim->imu();
   size_t g = 0;
-  sensor_msgs::CameraInfo info;
   const steadiface::CameraIntrinsics& k = sim->intrinsics();
-  info.header.frame_id = "camera_optical";
-  info.width = k.width;
-  info.height = k.height;
-  info.distortion_model = "plumb_bob";
-  info.D = {0, 0, 0, 0, 0};
-  info.K = {k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1};
-  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  info.P = {k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0};
+  // Writes IMU samples [g, end) whose stamps are <= until (all if none).
+  auto write_imu = [&](const ros::Time* until) {
+    for (; g < imu.size() && (!until || to_ros(imu[g].stamp) <= *until); ++g) {
+      sensor_msgs::Imu m;
+      m.header.stamp = to_ros(imu[g].stamp);
+      m.header.frame_id = "camera_optical";
+      m.angular_velocity.x = imu[g].angular_velocity.x();
+      m.angular_velocity.y = imu[g].angular_velocity.y();
+      m.angular_velocity.z = imu[g].angular_velocity.z();
+      m.orientation_covariance[0] = -1;
+      bag.write("/imu", m.header.stamp, m);
+    }
+  };
   std::ofstream csv(out + ".truth.csv");
   csv << "frame,stamp,head_x,head_y,head_in_view,face_scale_px,occluded,face_out,second_face";
   for (int r = 0; r < 16; ++r) csv << ",row" << r << "_qx,row" << r << "_qy,row" << r << "_qz,row" << r << "_qw";
@@ -114,17 +118,7 @@ int main(int argc, char** argv) {
     // The camera's last row is captured at stamp + readout; IMU samples up
     // to then are recorded before the image.
     const ros::Time last_row = stamp + ros::Duration(o.readout_s);
-    while (g < imu.size() && to_ros(imu[g].stamp) <= last_row) {
-      sensor_msgs::Imu m;
-      m.header.stamp = to_ros(imu[g].stamp);
-      m.header.frame_id = "camera_optical";
-      m.angular_velocity.x = imu[g].angular_velocity.x();
-      m.angular_velocity.y = imu[g].angular_velocity.y();
-      m.angular_velocity.z = imu[g].angular_velocity.z();
-      m.orientation_covariance[0] = -1;
-      bag.write("/imu", m.header.stamp, m);
-      ++g;
-    }
+    write_imu(&last_row);
     cv::Mat img = frame;
     std::string enc = sensor_msgs::image_encodings::BGR8;
     if (mono) {
@@ -135,25 +129,15 @@ int main(int argc, char** argv) {
     h.stamp = stamp;
     h.frame_id = "camera_optical";
     h.seq = i;
-    info.header = h;
-    bag.write("/camera/image_raw", stamp + ros::Duration(o.readout_s), cv_bridge::CvImage(h, enc, img).toImageMsg());
-    bag.write("/camera/camera_info", stamp + ros::Duration(o.readout_s), info);
+    bag.write("/camera/image_raw", last_row, cv_bridge::CvImage(h, enc, img).toImageMsg());
+    bag.write("/camera/camera_info", last_row, steadiface_ros::ToCameraInfo(k, h));
     csv << i << "," << stamp.toSec() << "," << truth.head_px.x() << "," << truth.head_px.y() << ","
         << truth.head_in_view << "," << truth.face_scale_px << "," << truth.occluded << ","
         << truth.face_out << "," << truth.second_face;
     for (const auto& q : truth.R_r) csv << "," << q.x() << "," << q.y() << "," << q.z() << "," << q.w();
     csv << "\n";
   }
-  for (; g < imu.size(); ++g) {
-    sensor_msgs::Imu m;
-    m.header.stamp = to_ros(imu[g].stamp);
-    m.header.frame_id = "camera_optical";
-    m.angular_velocity.x = imu[g].angular_velocity.x();
-    m.angular_velocity.y = imu[g].angular_velocity.y();
-    m.angular_velocity.z = imu[g].angular_velocity.z();
-    m.orientation_covariance[0] = -1;
-    bag.write("/imu", m.header.stamp, m);
-  }
+  write_imu(nullptr);
   bag.close();
   if (std::rename(tmp.c_str(), out.c_str()) != 0) {
     std::cerr << "steadiface_simulate: cannot rename " << tmp << "\n";

@@ -309,9 +309,8 @@ bool FaceTracker::Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiri
   return fail == FaceFailure::kNone;
 }
 
-void FaceTracker::Accept(const cv::Mat* gray, const Candidate& c, bool acquiring,
-                         const cv::Mat& patch, Time stamp, FaceInfo* info) {
-  (void)gray;
+void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,
+                         Time stamp, FaceInfo* info) {
   if (acquiring) {
     reference_shape_ = Normalize(c.landmarks);
     reference_patch_ = patch.empty() ? cv::Mat() : patch.clone();
@@ -454,7 +453,7 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
       }
     }
     if (ok) {
-      Accept(&gray, c, true, patch, stamp, info);
+      Accept(c, true, patch, stamp, info);
     } else {
       MarkFailure(faces.empty() ? FaceFailure::kNoFace : info->failure, stamp, info);
     }
@@ -508,7 +507,7 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
       info->failure = FaceFailure::kOutOfFrame;
     }
     if (ok) {
-      Accept(&gray, c, false, patch, stamp, info);
+      Accept(c, false, patch, stamp, info);
     } else {
       MarkFailure(info->failure == FaceFailure::kNone ? FaceFailure::kNoFace : info->failure,
                   stamp, info);
@@ -562,7 +561,7 @@ Status FaceTracker::ProcessExternal(const std::vector<Eigen::Vector2d>& lm,
     }
     cv::Mat patch;
     if (Evaluate(nullptr, c, acquiring, acquiring ? nullptr : &pc, info, &patch)) {
-      Accept(nullptr, c, acquiring, patch, stamp, info);
+      Accept(c, acquiring, patch, stamp, info);
       info->confidence *= std::min(1.0, std::max(0.0, external_confidence));
     } else {
       MarkFailure(info->failure, stamp, info);

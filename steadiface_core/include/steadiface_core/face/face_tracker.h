@@ -105,8 +105,8 @@ class FaceTracker {
   bool Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiring,
                 const Eigen::Vector2d* predicted_centre, FaceInfo* info,
                 cv::Mat* patch) const;
-  void Accept(const cv::Mat* gray, const Candidate& c, bool acquiring,
-              const cv::Mat& patch, Time stamp, FaceInfo* info);
+  void Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,
+              Time stamp, FaceInfo* info);
   void Fill(const std::vector<Eigen::Vector2d>& landmarks, FaceInfo* info) const;
   bool PredictLandmarks(Time stamp, const OrientationTimeline* timeline,
                         const RowTiming* timing,
