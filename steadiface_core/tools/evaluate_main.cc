@@ -3,7 +3,7 @@
 // report.json and per-(preset, method) trajectory CSVs for the plots.
 //
 //   steadiface_evaluate --data test/data --out out/eval
-//       [--presets walk,run] [--methods none,gyro-only,steadiface]
+//       [--presets walk,run] [--methods none,gyro-only,steadiface,...]
 //       [--duration 3] [--size 640x360] [--seed 1] [--render]
 #include <cstdio>
 #include <cstring>
@@ -14,7 +14,15 @@
 #include <sys/stat.h>
 #include <vector>
 
+#include <unistd.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+
+#include "steadiface_core/eval/ffmpeg_baseline.h"
 #include "steadiface_core/eval/run_methods.h"
+#include "steadiface_core/eval/video_scorer.h"
 
 namespace {
 
@@ -32,7 +40,8 @@ std::vector<std::string> Split(const std::string& s) {
 
 int Usage() {
   std::cerr << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
-               "       [--methods none,gyro-only,steadiface] [--duration S]\n"
+               "       [--methods none,gyro-only,steadiface,none/video,\n"
+               "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
                "       [--size WxH] [--seed N] [--render]\n";
   return 2;
 }
@@ -42,7 +51,7 @@ int Usage() {
 int main(int argc, char** argv) {
   std::string data, out_dir;
   std::vector<std::string> presets = steadiface::sim::PresetNames();
-  std::vector<std::string> methods = {"none", "gyro-only", "steadiface"};
+  std::vector<std::string> methods;  // empty: the default set
   double duration = 3.0;
   int width = 640, height = 360;
   uint64_t seed = 1;
@@ -64,16 +73,53 @@ int main(int argc, char** argv) {
     }
   }
   if (data.empty() || out_dir.empty()) return Usage();
+  std::string ffmpeg_version;
+  const bool have_ffmpeg = steadiface::eval::FfmpegAvailable(&ffmpeg_version);
+  if (methods.empty()) {
+    methods = {"none", "gyro-only", "steadiface"};
+    if (have_ffmpeg) {
+      // The peers, and the approximate scoring path applied to the input and
+      // to steadiface's output, so its error can be read off the table.
+      methods.insert(methods.end(),
+                     {"none/video", "steadiface/video", "ffmpeg-vidstab", "ffmpeg-deshake"});
+    } else {
+      std::cerr << "ffmpeg with vidstab/deshake not found: peer baselines skipped\n";
+    }
+  }
+  for (const std::string& name : methods) {
+    if (name != "none" && name != "gyro-only" && name != "steadiface" && name != "none/video" &&
+        name != "steadiface/video" && name != "gyro-only/video" && name != "ffmpeg-vidstab" &&
+        name != "ffmpeg-deshake") {
+      std::cerr << "unknown method " << name << "\n";
+      return 2;
+    }
+    if (name.compare(0, 7, "ffmpeg-") == 0 && !have_ffmpeg) {
+      std::cerr << "method " << name << " needs ffmpeg with the vidstab and deshake filters\n";
+      return 2;
+    }
+  }
   mkdir(out_dir.c_str(), 0755);
   std::ofstream json(out_dir + "/report.json");
   json << "{\n  \"duration_s\": " << duration << ",\n  \"size\": [" << width << ", "
-       << height << "],\n  \"seed\": " << seed << ",\n  \"results\": [\n";
+       << height << "],\n  \"seed\": " << seed << ",\n  \"ffmpeg\": \""
+       << (have_ffmpeg ? ffmpeg_version : "") << "\",\n  \"results\": [\n";
   std::cout << "| preset | method | head jitter px | head jitter %diag | background jitter px"
                " | head stability | bg stability | cropping | distortion | undefined frames |"
-               " solver p50 ms | face p50 ms |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+               " solver p50 ms | face p50 ms | scoring |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   bool first = true;
   int failures = 0;
+  auto fmt = [](const char* f, double v) {
+    if (!std::isfinite(v)) return std::string("–");
+    char b[64];
+    std::snprintf(b, sizeof(b), f, v);
+    return std::string(b);
+  };
+  auto jnum = [](double v) {
+    std::ostringstream o;
+    if (std::isfinite(v)) o << v; else o << "null";
+    return o.str();
+  };
   for (const std::string& preset : presets) {
     steadiface::sim::SimulatorOptions so;
     so.data_dir = data;
@@ -89,67 +135,139 @@ int main(int argc, char** argv) {
       ++failures;
       continue;
     }
+    std::string input_video;  // lossless input for the ffmpeg peers, once per preset
     for (const std::string& name : methods) {
-      Method m;
-      if (name == "none") m = Method::kNone;
-      else if (name == "gyro-only") m = Method::kGyroOnly;
-      else if (name == "steadiface") m = Method::kSteadiface;
-      else {
-        std::cerr << "unknown method " << name << "\n";
-        return 2;
+      const bool video = name.size() > 6 && name.compare(name.size() - 6, 6, "/video") == 0;
+      const bool peer = name.compare(0, 7, "ffmpeg-") == 0;
+      const std::string base = video ? name.substr(0, name.size() - 6) : name;
+      steadiface::eval::Score sc;
+      double solver = NAN, face = NAN, peer_ms = NAN;
+      double face_fraction = NAN;
+      std::unique_ptr<steadiface::eval::VideoScorer> vs;
+      if (video || peer) {
+        steadiface::eval::VideoScorerOptions vo;
+        vo.fps = so.fps;
+        s = steadiface::eval::VideoScorer::Create(sim->intrinsics(), vo, &vs);
+        if (!s.ok()) {
+          std::cerr << name << ": " << s.message() << "\n";
+          return 1;
+        }
       }
-      const steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
-      steadiface::CameraModel model;
-      steadiface::CameraModel::Create(sim->intrinsics(), po.camera, &model);
-      steadiface::OutputGeometry og;
-      steadiface::OutputGeometry::Create(model, po.warp.output, &og);
-      steadiface::eval::Scorecard card(*sim, model, og, steadiface::eval::ScorecardOptions());
-      s = steadiface::eval::RunMethod(*sim, m, po, render, &card, nullptr);
+      if (peer) {
+        if (input_video.empty()) {
+          char tmpl[] = "/tmp/steadiface_eval_XXXXXX";
+          if (mkdtemp(tmpl) == nullptr) {
+            std::cerr << "cannot create a temporary directory\n";
+            return 1;
+          }
+          const std::string path = std::string(tmpl) + "/input.mkv";
+          steadiface::eval::LosslessVideoWriter w;
+          s = w.Open(path, width, height, so.fps);
+          cv::Mat frame;
+          steadiface::sim::SimTruth truth;
+          for (int i = 0; s.ok() && i < sim->num_frames(); ++i) {
+            s = sim->Render(i, &frame, &truth);
+            if (s.ok()) s = w.Write(frame);
+          }
+          const steadiface::Status c = w.Close();
+          if (s.ok()) s = c;
+          if (!s.ok()) {
+            std::cerr << preset << ": lossless input: " << s.message() << "\n";
+            ++failures;
+            continue;
+          }
+          input_video = path;
+        }
+        const auto fm = name == "ffmpeg-vidstab" ? steadiface::eval::FfmpegMethod::kVidstab
+                                                 : steadiface::eval::FfmpegMethod::kDeshake;
+        // Time ffmpeg alone: collect its frames first, score afterwards.
+        std::vector<cv::Mat> frames;
+        double seconds = 0.0;
+        s = steadiface::eval::RunFfmpegStabilizer(
+            fm, input_video, width, height,
+            input_video.substr(0, input_video.rfind('/')),
+            [&frames](const cv::Mat& f) {
+              frames.push_back(f.clone());
+              return steadiface::Status::Ok();
+            },
+            &seconds);
+        for (size_t i = 0; s.ok() && i < frames.size(); ++i) s = vs->Add(frames[i]);
+        if (s.ok()) peer_ms = 1000.0 * seconds / std::max<size_t>(1, frames.size());
+      } else {
+        const Method m = base == "none" ? Method::kNone
+                         : base == "gyro-only" ? Method::kGyroOnly : Method::kSteadiface;
+        const steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
+        steadiface::CameraModel model;
+        steadiface::CameraModel::Create(sim->intrinsics(), po.camera, &model);
+        steadiface::OutputGeometry og;
+        steadiface::OutputGeometry::Create(model, po.warp.output, &og);
+        steadiface::eval::Scorecard card(*sim, model, og, steadiface::eval::ScorecardOptions());
+        steadiface::eval::VideoScorer* vsp = vs.get();
+        s = steadiface::eval::RunMethod(
+            *sim, m, po, render || video, &card, nullptr,
+            video ? std::function<steadiface::Status(const cv::Mat&)>(
+                        [vsp](const cv::Mat& f) { return vsp->Add(f); })
+                  : nullptr);
+        if (s.ok() && !video) {
+          sc = card.Compute();
+          for (const auto& st : sc.stage_ms) {
+            if (st.first == "solver") solver = st.second.first;
+            if (st.first == "face") face = st.second.first;
+          }
+          std::ofstream csv(out_dir + "/traj_" + preset + "_" + name + ".csv");
+          csv << "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
+                 "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
+          for (const auto& p : card.samples()) {
+            csv << p.t << "," << p.head_in.x() << "," << p.head_in.y() << "," << p.head_out.x()
+                << "," << p.head_out.y() << "," << p.head_valid << "," << p.background_out.x()
+                << "," << p.background_out.y() << "," << p.virtual_angle[0] << ","
+                << p.virtual_angle[1] << "," << p.virtual_angle[2] << "," << p.real_angle[0]
+                << "," << p.real_angle[1] << "," << p.real_angle[2] << "," << p.offset.x()
+                << "," << p.offset.y() << "\n";
+          }
+        }
+      }
       if (!s.ok()) {
         std::cerr << preset << "/" << name << ": " << s.message() << "\n";
         ++failures;
         continue;
       }
-      const steadiface::eval::Score sc = card.Compute();
-      double solver = 0, face = 0;
-      for (const auto& st : sc.stage_ms) {
-        if (st.first == "solver") solver = st.second.first;
-        if (st.first == "face") face = st.second.first;
+      if (vs) {
+        sc = vs->Compute();
+        face_fraction = vs->face_fraction();
       }
-      char line[512];
-      std::snprintf(line, sizeof(line),
-                    "| %s | %s | %.2f | %.3f | %.2f | %.2f | %.2f | %.2f | %.3f | %.1f%% | %.3f | %.2f |\n",
-                    preset.c_str(), name.c_str(), sc.head_jitter_px, 100 * sc.head_jitter_frac,
-                    sc.background_jitter_px, sc.head_stability, sc.background_stability,
-                    sc.cropping, sc.distortion, 100 * sc.undefined_fraction, solver, face);
-      std::cout << line << std::flush;
+      const std::string scoring = vs ? "approximate" : "exact";
+      std::cout << "| " << preset << " | " << name << " | " << fmt("%.2f", sc.head_jitter_px)
+                << " | " << fmt("%.3f", 100 * sc.head_jitter_frac) << " | "
+                << fmt("%.2f", sc.background_jitter_px) << " | "
+                << fmt("%.2f", sc.head_stability) << " | "
+                << fmt("%.2f", sc.background_stability) << " | " << fmt("%.2f", sc.cropping)
+                << " | " << fmt("%.3f", sc.distortion) << " | "
+                << fmt("%.1f%%", 100 * sc.undefined_fraction) << " | " << fmt("%.3f", solver)
+                << " | " << fmt("%.2f", face) << " | " << scoring << " |" << std::endl;
       json << (first ? "" : ",\n") << "    {\"preset\": \"" << preset << "\", \"method\": \""
-           << name << "\", \"frames\": " << sc.frames
-           << ", \"head_jitter_px\": " << sc.head_jitter_px
-           << ", \"head_jitter_frac\": " << sc.head_jitter_frac
-           << ", \"background_jitter_px\": " << sc.background_jitter_px
-           << ", \"background_jitter_frac\": " << sc.background_jitter_frac
-           << ", \"head_stability\": " << sc.head_stability
-           << ", \"background_stability\": " << sc.background_stability
-           << ", \"cropping\": " << sc.cropping << ", \"distortion\": " << sc.distortion
-           << ", \"undefined_fraction\": " << sc.undefined_fraction << ", \"stage_ms\": {";
+           << name << "\", \"scoring\": \"" << scoring << "\", \"frames\": " << sc.frames
+           << ", \"head_jitter_px\": " << jnum(sc.head_jitter_px)
+           << ", \"head_jitter_frac\": " << jnum(sc.head_jitter_frac)
+           << ", \"background_jitter_px\": " << jnum(sc.background_jitter_px)
+           << ", \"background_jitter_frac\": " << jnum(sc.background_jitter_frac)
+           << ", \"head_stability\": " << jnum(sc.head_stability)
+           << ", \"background_stability\": " << jnum(sc.background_stability)
+           << ", \"cropping\": " << jnum(sc.cropping) << ", \"distortion\": " << jnum(sc.distortion)
+           << ", \"undefined_fraction\": " << jnum(sc.undefined_fraction)
+           << ", \"face_fraction\": " << jnum(face_fraction)
+           << ", \"peer_wall_ms_per_frame\": " << jnum(peer_ms) << ", \"stage_ms\": {";
       for (size_t k = 0; k < sc.stage_ms.size(); ++k) {
         json << (k ? ", " : "") << "\"" << sc.stage_ms[k].first << "\": ["
              << sc.stage_ms[k].second.first << ", " << sc.stage_ms[k].second.second << "]";
       }
       json << "}}";
       first = false;
-      std::ofstream csv(out_dir + "/traj_" + preset + "_" + name + ".csv");
-      csv << "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
-             "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
-      for (const auto& p : card.samples()) {
-        csv << p.t << "," << p.head_in.x() << "," << p.head_in.y() << "," << p.head_out.x()
-            << "," << p.head_out.y() << "," << p.head_valid << "," << p.background_out.x()
-            << "," << p.background_out.y() << "," << p.virtual_angle[0] << ","
-            << p.virtual_angle[1] << "," << p.virtual_angle[2] << "," << p.real_angle[0] << ","
-            << p.real_angle[1] << "," << p.real_angle[2] << "," << p.offset.x() << ","
-            << p.offset.y() << "\n";
-      }
+    }
+    if (!input_video.empty()) {
+      std::remove(input_video.c_str());
+      std::remove((input_video.substr(0, input_video.rfind('/')) + "/vidstab.trf").c_str());
+      rmdir(input_video.substr(0, input_video.rfind('/')).c_str());
     }
   }
   json << "\n  ]\n}\n";

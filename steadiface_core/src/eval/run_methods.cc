@@ -28,9 +28,19 @@ PipelineOptions OptionsFor(const sim::Simulator& sim, Method method) {
 }
 
 Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions& options,
-                 bool render, Scorecard* card, std::vector<StabilizerFrame>* frames_out) {
+                 bool render, Scorecard* card, std::vector<StabilizerFrame>* frames_out,
+                 const std::function<Status(const cv::Mat&)>& on_output) {
   if (method == Method::kNone) {
-    for (int i = 0; i < sim.num_frames(); ++i) card->Add(i, FrameWarp());
+    cv::Mat frame;
+    sim::SimTruth truth;
+    for (int i = 0; i < sim.num_frames(); ++i) {
+      card->Add(i, FrameWarp());
+      if (render && on_output) {
+        Status s = sim.Render(i, &frame, &truth);
+        if (s.ok()) s = on_output(frame);
+        if (!s.ok()) return s;
+      }
+    }
     return Status::Ok();
   }
   PipelineOptions o = options;
@@ -73,6 +83,10 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
       w.stage_ms.push_back({"warp", out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms});
     }
     card->Add(i, w);
+    if (render && on_output) {
+      s = on_output(out.output);
+      if (!s.ok()) return s;
+    }
     if (frames_out != nullptr) frames_out->push_back(out.stabilizer);
   }
   return Status::Ok();

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,10 +26,12 @@ PipelineOptions OptionsFor(const sim::Simulator& sim, Method method);
 /// Renders every frame, feeds the IMU and the frames through a Pipeline
 /// (render_output off unless `render`), and scores the warps. Fills
 /// `score` and `card` (for trajectories); `frames_out` (optional) receives
-/// the stabilizer frames.
+/// the stabilizer frames; `on_output` (optional, needs `render`) receives
+/// each output image (for kNone: the input frame).
 Status RunMethod(const sim::Simulator& sim, Method method,
                  const PipelineOptions& options, bool render,
-                 Scorecard* card, std::vector<StabilizerFrame>* frames_out);
+                 Scorecard* card, std::vector<StabilizerFrame>* frames_out,
+                 const std::function<Status(const cv::Mat&)>& on_output = nullptr);
 
 }  // namespace eval
 }  // namespace steadiface

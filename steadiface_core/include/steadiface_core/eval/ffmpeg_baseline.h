@@ -1,0 +1,55 @@
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/status.h"
+
+namespace steadiface {
+namespace eval {
+
+/// Peer stabilizers run through the `ffmpeg` command line, for the
+/// scorecard's baselines and the throughput comparison.
+enum class FfmpegMethod {
+  kVidstab,  ///< vidstabdetect then vidstabtransform (two passes), defaults
+  kDeshake,  ///< deshake, defaults
+};
+const char* FfmpegMethodName(FfmpegMethod m);
+
+/// True when `ffmpeg` is on PATH and has the vidstab and deshake filters;
+/// `version` (optional) receives its first version line.
+bool FfmpegAvailable(std::string* version);
+
+/// Writes frames (bgr8, all the same size) to a lossless FFV1 Matroska file
+/// through ffmpeg. Call `Write` per frame, then `Close`.
+class LosslessVideoWriter {
+ public:
+  LosslessVideoWriter() = default;
+  ~LosslessVideoWriter();
+  LosslessVideoWriter(const LosslessVideoWriter&) = delete;
+  LosslessVideoWriter& operator=(const LosslessVideoWriter&) = delete;
+
+  Status Open(const std::string& path, int width, int height, double fps);
+  Status Write(const cv::Mat& bgr);
+  Status Close();
+
+ private:
+  FILE* pipe_ = nullptr;
+  int width_ = 0, height_ = 0;
+};
+
+/// Runs `method` with its default settings on `input` (any video ffmpeg
+/// reads; converted to yuv420p first, the format phone videos come in and
+/// the one libvidstab handles — it aborts on packed or planar RGB), decoding the stabilized frames to bgr8 and handing each to
+/// `sink`. `work_dir` holds vidstab's transforms file. `seconds` receives
+/// the wall time of the ffmpeg passes (including decoding the input and
+/// handing frames over).
+Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int width,
+                           int height, const std::string& work_dir,
+                           const std::function<Status(const cv::Mat&)>& sink,
+                           double* seconds);
+
+}  // namespace eval
+}  // namespace steadiface
