@@ -42,7 +42,7 @@ int Usage() {
   std::cerr << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
                "       [--methods none,gyro-only,steadiface,none/video,\n"
                "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
-               "       [--size WxH] [--seed N] [--render]\n";
+               "       [--size WxH] [--seed N] [--render] [--crop R]\n";
   return 2;
 }
 
@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   int width = 640, height = 360;
   uint64_t seed = 1;
   bool render = false;
+  double crop = NAN;  // NaN: the package default
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
     else if (a == "--duration") duration = std::atof(next().c_str());
     else if (a == "--seed") seed = std::strtoull(next().c_str(), nullptr, 10);
     else if (a == "--render") render = true;
+    else if (a == "--crop") crop = std::atof(next().c_str());
     else if (a == "--size") {
       if (std::sscanf(next().c_str(), "%dx%d", &width, &height) != 2) return Usage();
     } else {
@@ -196,7 +198,8 @@ int main(int argc, char** argv) {
       } else {
         const Method m = base == "none" ? Method::kNone
                          : base == "gyro-only" ? Method::kGyroOnly : Method::kSteadiface;
-        const steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
+        steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
+        if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
         steadiface::CameraModel model;
         steadiface::CameraModel::Create(sim->intrinsics(), po.camera, &model);
         steadiface::OutputGeometry og;

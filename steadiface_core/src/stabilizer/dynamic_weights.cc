@@ -89,8 +89,10 @@ WeightFactors DynamicWeights::Update(double dt_s, double mean_angular_speed,
     return cur + a * (target - cur);
   };
   if (!initialized_) {
-    // Start from "no face": w_f fades in even on the very first face.
-    presence_ = 0.0;
+    // The stream's first frame: there is no previous virtual camera to jump
+    // from (it starts at the real one with H = C), so w_f starts at its
+    // target; every later appearance or loss fades.
+    presence_ = f.presence_target;
     fit_gyro_ = f.gyro_target;
     fit_pose_ = f.pose_target;
     fit_var_ = f.variation_target;
