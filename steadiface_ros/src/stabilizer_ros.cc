@@ -168,6 +168,12 @@ void StabilizerRos::Error(const std::string& key, const std::string& text) {
   ROS_ERROR_STREAM_THROTTLE_NAMED(5.0, key, "[" << name_ << "] " << text);
 }
 
+void StabilizerRos::OnTimeJump() {
+  // The wrapper's callbacks run on the subscriber threads; tf2's buffer is
+  // thread-safe.
+  tf_buffer_->clear();
+}
+
 void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
   const WrapperStatus w = wrapper_->Status();
   const double since = (ros::WallTime::now() - last_imu_wall_).toSec();

@@ -73,6 +73,7 @@ void StabilizerWrapper::ResetAll(const char* why) {
   last_frame_stamp_ = ros::Time();
   last_tf_stamp_ = ros::Time();
   have_last_imu_ = false;
+  sink_->OnTimeJump();
 }
 
 void StabilizerWrapper::OnImu(const sensor_msgs::Imu& msg) {

@@ -54,6 +54,7 @@ class StabilizerRos : public OutputSink {
   void PublishDebugImage(const sensor_msgs::ImagePtr& image) override;
   void Warn(const std::string& key, const std::string& text) override;
   void Error(const std::string& key, const std::string& text) override;
+  void OnTimeJump() override;
 
  private:
   void OnImage(const sensor_msgs::ImageConstPtr& image,

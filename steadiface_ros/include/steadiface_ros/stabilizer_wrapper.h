@@ -40,6 +40,10 @@ class OutputSink {
   /// Throttled log lines (the nodelet maps them to NODELET_*_THROTTLE).
   virtual void Warn(const std::string& key, const std::string& text) = 0;
   virtual void Error(const std::string& key, const std::string& text) = 0;
+  /// Time jumped backwards and the wrapper reset; a front end drops state
+  /// keyed by time (the nodelet clears its TF buffer, which would otherwise
+  /// refuse the new epoch's transforms as TF_OLD_DATA).
+  virtual void OnTimeJump() {}
 };
 
 /// Counters behind the diagnostics, all since start.
