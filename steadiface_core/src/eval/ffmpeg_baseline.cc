@@ -101,6 +101,41 @@ Status LosslessVideoWriter::Close() {
   return PcloseStatus(p, "ffmpeg (lossless encode)");
 }
 
+Status ReadVideo(const std::string& path, const std::function<Status(const cv::Mat&)>& sink,
+                 int* width, int* height) {
+  const std::string probe = RunCapture(
+      "ffprobe -v error -select_streams v:0 -show_entries stream=width,height -of csv=p=0 " +
+      Quote(path) + " 2>/dev/null");
+  int w = 0, h = 0;
+  if (std::sscanf(probe.c_str(), "%d,%d", &w, &h) != 2 || w <= 0 || h <= 0) {
+    return Status::Error("cannot read the video size of '" + path + "' (ffprobe)");
+  }
+  if (width != nullptr) *width = w;
+  if (height != nullptr) *height = h;
+  const std::string cmd = "ffmpeg -hide_banner -loglevel error -nostdin -i " + Quote(path) +
+                          " -f rawvideo -pix_fmt bgr24 -";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return Status::Error("cannot start ffmpeg");
+  cv::Mat frame(h, w, CV_8UC3);
+  const size_t bytes = frame.total() * 3;
+  Status s = Status::Ok();
+  int frames = 0;
+  while (s.ok() && fread(frame.data, 1, bytes, p) == bytes) {
+    ++frames;
+    s = sink(frame);
+  }
+  if (!s.ok()) {
+    char buf[65536];
+    while (fread(buf, 1, sizeof(buf), p) > 0) {
+    }
+    pclose(p);
+    return s;
+  }
+  s = PcloseStatus(p, "ffmpeg (decoding " + path + ")");
+  if (s.ok() && frames == 0) return Status::Error("'" + path + "' has no frames");
+  return s;
+}
+
 Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int width,
                            int height, const std::string& work_dir,
                            const std::function<Status(const cv::Mat&)>& sink,

@@ -40,6 +40,11 @@ class LosslessVideoWriter {
   int width_ = 0, height_ = 0;
 };
 
+/// Decodes any video ffmpeg reads to bgr8 frames, handing each to `sink`;
+/// `width`/`height` receive the size (from ffprobe).
+Status ReadVideo(const std::string& path, const std::function<Status(const cv::Mat&)>& sink,
+                 int* width, int* height);
+
 /// Runs `method` with its default settings on `input` (any video ffmpeg
 /// reads; converted to yuv420p first, the format phone videos come in and
 /// the one libvidstab handles — it aborts on packed or planar RGB), decoding the stabilized frames to bgr8 and handing each to
