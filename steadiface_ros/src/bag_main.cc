@@ -11,12 +11,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include <cv_bridge/cv_bridge.h>
 #include <opencv2/imgproc.hpp>
@@ -36,6 +41,128 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Threading: three threads, so reading (LZ4 decompression, deserialization),
+// stabilizing and writing overlap. The reader thread fills a bounded queue
+// of decoded messages in bag order; the main thread runs the wrapper exactly
+// as before (same order, same results: only I/O moved); the writer thread
+// drains a bounded queue of bag writes. Bounded both ways, so memory stays
+// at a few frames whatever the bag size.
+template <typename T>
+class BoundedQueue {
+ public:
+  explicit BoundedQueue(size_t capacity) : capacity_(capacity) {}
+  // Blocks while full; false once closed.
+  bool Push(T item) {
+    std::unique_lock<std::mutex> l(m_);
+    not_full_.wait(l, [&] { return q_.size() < capacity_ || closed_; });
+    if (closed_) return false;
+    q_.push_back(std::move(item));
+    not_empty_.notify_one();
+    return true;
+  }
+  // Blocks while empty; false once closed and drained.
+  bool Pop(T* item) {
+    std::unique_lock<std::mutex> l(m_);
+    not_empty_.wait(l, [&] { return !q_.empty() || closed_; });
+    if (q_.empty()) return false;
+    *item = std::move(q_.front());
+    q_.pop_front();
+    not_full_.notify_one();
+    return true;
+  }
+  void Close() {
+    std::lock_guard<std::mutex> l(m_);
+    closed_ = true;
+    not_empty_.notify_all();
+    not_full_.notify_all();
+  }
+
+ private:
+  const size_t capacity_;
+  std::mutex m_;
+  std::condition_variable not_full_, not_empty_;
+  std::deque<T> q_;
+  bool closed_ = false;
+};
+
+// Bag writes on their own thread; the first write error is kept and
+// reported at the end (the output is then not renamed into place).
+class AsyncBagWriter {
+ public:
+  explicit AsyncBagWriter(rosbag::Bag* bag) : bag_(bag), queue_(64) {
+    thread_ = std::thread([this] {
+      std::function<void()> job;
+      while (queue_.Pop(&job)) {
+        if (!error_.empty()) continue;  // drain after a failure
+        try {
+          job();
+        } catch (const std::exception& e) {
+          error_ = e.what();
+        }
+      }
+    });
+  }
+  ~AsyncBagWriter() { Finish(); }
+  template <typename M>
+  void Write(const std::string& topic, const ros::Time& t, const boost::shared_ptr<const M>& m) {
+    rosbag::Bag* bag = bag_;
+    queue_.Push([bag, topic, t, m] { bag->write(topic, t, *m); });
+  }
+  template <typename M>
+  void WriteCopy(const std::string& topic, const ros::Time& t, const M& m) {
+    Write(topic, t, boost::shared_ptr<const M>(new M(m)));
+  }
+  // Waits for every queued write; returns the first error ("" if none).
+  std::string Finish() {
+    if (thread_.joinable()) {
+      queue_.Close();
+      thread_.join();
+    }
+    return error_;
+  }
+
+ private:
+  rosbag::Bag* bag_;
+  BoundedQueue<std::function<void()>> queue_;
+  std::thread thread_;
+  std::string error_;  // written by the writer thread only, read after join
+};
+
+// Video frames encoded on their own thread (cv::VideoWriter is used by that
+// thread only once started).
+class AsyncVideoWriter {
+ public:
+  explicit AsyncVideoWriter(cv::VideoWriter* video) : video_(video), queue_(8) {
+    thread_ = std::thread([this] {
+      cv::Mat frame;
+      while (queue_.Pop(&frame)) video_->write(frame);
+    });
+  }
+  ~AsyncVideoWriter() { Finish(); }
+  void Write(const cv::Mat& frame) { queue_.Push(frame); }
+  void Finish() {
+    if (thread_.joinable()) {
+      queue_.Close();
+      thread_.join();
+    }
+  }
+
+ private:
+  cv::VideoWriter* video_;
+  BoundedQueue<cv::Mat> queue_;
+  std::thread thread_;
+};
+
+// One decoded bag message.
+struct BagItem {
+  std::string topic;  // normalized
+  ros::Time time;
+  sensor_msgs::ImuConstPtr imu;
+  sensor_msgs::CameraInfoConstPtr info;
+  sensor_msgs::ImageConstPtr image;
+  steadiface::FaceLandmarksConstPtr landmarks;
+};
+
 struct Args {
   std::string in, out, video, report, trajectory, truth, plot_dir, plot_name = "bag";
   std::vector<std::string> params;
@@ -43,6 +170,7 @@ struct Args {
               imu_topic = "imu", landmarks_topic;
   bool debug_overlay = false, gyro_only = false, quiet = false;
   double start_stamp = 0.0;  // images before this stamp are skipped
+  std::string only_stamps;   // file of image stamps [s] to process; others skipped
 };
 
 int Usage() {
@@ -53,7 +181,9 @@ int Usage() {
          "  [--trajectory OUT.csv] [--gyro-only] [--quiet]\n"
          "  [--truth IN.bag.truth.csv (default: found beside the bag)]\n"
          "  [--plots DIR --name NAME: trajectories for scripts/plot_report.py]\n"
-         "  [--start-stamp S: skip images stamped before S (IMU is still read)]\n";
+         "  [--start-stamp S: skip images stamped before S (IMU is still read)]\n"
+         "  [--only-stamps FILE: process only the images whose stamps [s] are listed,\n"
+         "   one per line (to replay exactly the frames a live run received)]\n";
   return 2;
 }
 
@@ -72,7 +202,7 @@ double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps, double cut
 // and the report.
 class BagSink : public steadiface_ros::OutputSink {
  public:
-  rosbag::Bag* out = nullptr;
+  AsyncBagWriter* out = nullptr;
   bool debug = false;
   // Same names as the node publishes in the camera's namespace.
   std::string ns = "/camera";
@@ -89,31 +219,33 @@ class BagSink : public steadiface_ros::OutputSink {
     last_image = image;
     last_info = *info;
     if (out) {
-      out->write(T("image_stabilized/image_raw"), image->header.stamp, *image);
-      out->write(T("image_stabilized/camera_info"), info->header.stamp, *info);
+      out->Write(T("image_stabilized/image_raw"), image->header.stamp,
+                 sensor_msgs::ImageConstPtr(image));
+      out->Write(T("image_stabilized/camera_info"), info->header.stamp,
+                 sensor_msgs::CameraInfoConstPtr(info));
     }
   }
   void PublishLandmarks(const steadiface::FaceLandmarks& m) override {
     landmarks.push_back(m);
-    if (out) out->write(T("face_landmarks"), m.header.stamp, m);
+    if (out) out->WriteCopy(T("face_landmarks"), m.header.stamp, m);
   }
   void PublishState(const steadiface::StabilizerState& m) override {
     states.push_back(m);
     infos_out.push_back(last_info);  // PublishImage precedes PublishState
-    if (out) out->write(T("state"), m.header.stamp, m);
+    if (out) out->WriteCopy(T("state"), m.header.stamp, m);
   }
   void PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) override {
     tfs.insert(tfs.end(), tf.begin(), tf.end());
     if (out && !tf.empty()) {
       tf2_msgs::TFMessage m;
       m.transforms = tf;
-      out->write("/tf", tf.front().header.stamp, m);
+      out->WriteCopy("/tf", tf.front().header.stamp, m);
     }
   }
   bool WantsDebugImage() const override { return debug; }
   void PublishDebugImage(const sensor_msgs::ImagePtr& image) override {
     last_debug = image;
-    if (out) out->write(T("debug_image"), image->header.stamp, *image);
+    if (out) out->Write(T("debug_image"), image->header.stamp, sensor_msgs::ImageConstPtr(image));
   }
   void Warn(const std::string& key, const std::string& text) override {
     if (warnings[key]++ == 0) std::cerr << "warning: " << text << "\n";
@@ -145,6 +277,7 @@ int main(int argc, char** argv) {
     else if (s == "--quiet") a.quiet = true;
     else if (s == "--truth") a.truth = next();
     else if (s == "--start-stamp") a.start_stamp = std::atof(next().c_str());
+    else if (s == "--only-stamps") a.only_stamps = next();
     else if (s == "--plots") a.plot_dir = next();
     else if (s == "--name") a.plot_name = next();
     else return Usage();
@@ -220,7 +353,11 @@ int main(int argc, char** argv) {
       std::cerr << "steadiface_bag: cannot write '" << out_tmp << "': " << e.what() << "\n";
       return 1;
     }
-    sink.out = &out;
+  }
+  std::unique_ptr<AsyncBagWriter> writer;
+  if (!a.out.empty()) {
+    writer.reset(new AsyncBagWriter(&out));
+    sink.out = writer.get();
   }
   steadiface_ros::StabilizerWrapper wrapper(po, wo, &sink);
 
@@ -242,6 +379,7 @@ int main(int argc, char** argv) {
   bool have_in_info = false;
   std::deque<sensor_msgs::ImageConstPtr> waiting;  // images whose info has not arrived
   cv::VideoWriter video;
+  std::unique_ptr<AsyncVideoWriter> video_writer;
   const std::string video_tmp = a.video.empty() ? "" : a.video + ".part.mp4";
   std::map<ros::Time, cv::Mat> inputs;  // for the side-by-side video, bounded
   const bool tty = isatty(STDERR_FILENO) && !a.quiet;
@@ -272,27 +410,68 @@ int main(int argc, char** argv) {
         a.video.clear();
         return;
       }
+      video_writer.reset(new AsyncVideoWriter(&video));
     }
-    video.write(both);
+    video_writer->Write(both);
     inputs.erase(inputs.begin(), std::next(it));
     sink.last_image.reset();
   };
-  for (const rosbag::MessageInstance& m : view) {
-    const std::string topic = norm(m.getTopic());
+  std::set<int64_t> only;  // stamps in ms
+  if (!a.only_stamps.empty()) {
+    std::ifstream f(a.only_stamps);
+    if (!f) {
+      std::cerr << "steadiface_bag: cannot read '" << a.only_stamps << "'\n";
+      return 1;
+    }
+    double t;
+    while (f >> t) only.insert(std::llround(t * 1e3));
+    if (only.empty()) {
+      std::cerr << "steadiface_bag: no stamps in '" << a.only_stamps << "'\n";
+      return 1;
+    }
+  }
+  BoundedQueue<BagItem> read_queue(64);
+  std::string read_error;
+  std::thread reader([&] {
+    try {
+      for (const rosbag::MessageInstance& m : view) {
+        BagItem item;
+        item.topic = norm(m.getTopic());
+        item.time = m.getTime();
+        if (item.topic == norm(a.imu_topic)) {
+          item.imu = m.instantiate<sensor_msgs::Imu>();
+        } else if (item.topic == norm(a.info_topic)) {
+          item.info = m.instantiate<sensor_msgs::CameraInfo>();
+        } else if (item.topic == norm(a.landmarks_topic)) {
+          item.landmarks = m.instantiate<steadiface::FaceLandmarks>();
+        } else if (item.topic == norm(a.image_topic)) {
+          item.image = m.instantiate<sensor_msgs::Image>();
+        }
+        if (!read_queue.Push(std::move(item))) break;
+      }
+    } catch (const std::exception& e) {
+      read_error = e.what();
+    }
+    read_queue.Close();
+  });
+  BagItem item;
+  while (read_queue.Pop(&item)) {
+    const std::string& topic = item.topic;
     if (topic == norm(a.imu_topic)) {
-      if (auto imu = m.instantiate<sensor_msgs::Imu>()) wrapper.OnImu(*imu);
+      if (auto imu = item.imu) wrapper.OnImu(*imu);
     } else if (topic == norm(a.info_topic)) {
-      if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
+      if (auto info = item.info) {
         in_info = *info;
         have_in_info = true;
         infos[info->header.stamp] = info;
         while (infos.size() > 64) infos.erase(infos.begin());
       }
     } else if (topic == norm(a.landmarks_topic)) {
-      if (auto lm = m.instantiate<steadiface::FaceLandmarks>()) wrapper.OnLandmarks(*lm);
+      if (auto lm = item.landmarks) wrapper.OnLandmarks(*lm);
     } else if (topic == norm(a.image_topic)) {
-      if (auto img = m.instantiate<sensor_msgs::Image>()) {
+      if (auto img = item.image) {
         if (img->header.stamp.toSec() < a.start_stamp - 1e-6) continue;
+        if (!only.empty() && !only.count(std::llround(img->header.stamp.toSec() * 1e3))) continue;
         waiting.push_back(img);
         ++images_seen;
       }
@@ -318,9 +497,9 @@ int main(int argc, char** argv) {
         if (steadiface_ros::ToCvImage(*img, &mat).ok()) inputs[img->header.stamp] = mat.clone();
         while (inputs.size() > 32) inputs.erase(inputs.begin());
       }
-      wrapper.OnImage(img, it->second, m.getTime());
+      wrapper.OnImage(img, it->second, item.time);
     }
-    wrapper.OnTimer(m.getTime());
+    wrapper.OnTimer(item.time);
     write_video();
     const size_t done = sink.states.size();
     if (done != state_written && (tty || done % 100 == 0)) {
@@ -338,11 +517,27 @@ int main(int argc, char** argv) {
       }
     }
   }
+  reader.join();
+  if (!read_error.empty()) {
+    std::cerr << "steadiface_bag: reading " << a.in << " failed: " << read_error << "\n";
+    if (writer) writer->Finish();
+    if (!a.out.empty()) std::remove(out_tmp.c_str());
+    return 1;
+  }
   wrapper.Flush();
   write_video();
   if (tty) fprintf(stderr, "\n");
-  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   in.close();
+  if (writer) {
+    const std::string err = writer->Finish();
+    if (!err.empty()) {
+      std::cerr << "steadiface_bag: writing " << out_tmp << " failed: " << err << "\n";
+      std::remove(out_tmp.c_str());
+      return 1;
+    }
+  }
+  if (video_writer) video_writer->Finish();
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   if (!a.out.empty()) {
     out.close();
     if (std::rename(out_tmp.c_str(), a.out.c_str()) != 0) {
