@@ -66,7 +66,7 @@ void BM_PipelineFrame(benchmark::State& state) {
   std::unique_ptr<Pipeline> p;
   size_t g = 0, i = 0;
   const auto& imu = seq.sim->imu();
-  std::vector<double> face, stab, warp;
+  std::vector<double> face, stab, warp, total;
   // A fresh pipeline that has acquired the face on the first frame.
   auto restart = [&]() -> bool {
     if (!Pipeline::Create(seq.sim->intrinsics(), po, &p).ok()) return false;
@@ -103,10 +103,14 @@ void BM_PipelineFrame(benchmark::State& state) {
     face.push_back(out.timings.face_ms);
     stab.push_back(out.timings.stabilizer_ms);
     warp.push_back(out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms);
+    total.push_back(out.timings.total_ms);
   }
   state.counters["face_ms"] = Median(face);
   state.counters["stabilizer_ms"] = Median(stab);
   state.counters["warp_ms"] = Median(warp);
+  // The headline target is a median (the reported time is a mean, which
+  // includes the periodic re-detection frames).
+  state.counters["total_p50_ms"] = Median(total);
   state.counters["face_valid"] = out.face.valid;
 }
 

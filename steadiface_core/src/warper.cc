@@ -1,5 +1,7 @@
 #include "steadiface_core/warper.h"
 
+#include <cstdint>
+
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -167,6 +169,34 @@ void Warper::BuildMaps() {
           // interpolation-table index in map2. Far-out coordinates clamp
           // (they sample the black border either way).
           const float s = static_cast<float>(kInterTabSize);
+          const float xe = x0 + dx * static_cast<float>(u1 - u0);
+          const float ye = y0 + dy * static_cast<float>(u1 - u0);
+          const float lim = 16000.0f;
+          if (u1 >= u0 && std::abs(x0) < lim && std::abs(y0) < lim && std::abs(xe) < lim &&
+              std::abs(ye) < lim) {
+            // Fast path (the whole segment in range, so no clamping): the
+            // 1/32 px coordinates are linear in u, so step them in integer
+            // fixed point (10 more fractional bits; the drift over a cell is
+            // < 0.05 of a 1/32 px step) — adds and shifts the compiler
+            // vectorizes instead of two float roundings per pixel.
+            constexpr int kFrac = 10;
+            const float f = s * static_cast<float>(1 << kFrac);
+            int32_t X = static_cast<int32_t>(std::lround(x0 * f)) + (1 << (kFrac - 1));
+            int32_t Y = static_cast<int32_t>(std::lround(y0 * f)) + (1 << (kFrac - 1));
+            const int32_t DX = static_cast<int32_t>(std::lround(dx * f));
+            const int32_t DY = static_cast<int32_t>(std::lround(dy * f));
+            for (int u = u0; u <= u1; ++u) {
+              const int32_t ix = X >> kFrac;
+              const int32_t iy = Y >> kFrac;
+              out1[2 * u] = static_cast<short>(ix >> kInterBits);
+              out1[2 * u + 1] = static_cast<short>(iy >> kInterBits);
+              out2[u] = static_cast<ushort>((iy & (kInterTabSize - 1)) * kInterTabSize +
+                                            (ix & (kInterTabSize - 1)));
+              X += DX;
+              Y += DY;
+            }
+            continue;
+          }
           for (int u = u0; u <= u1; ++u) {
             const float k = static_cast<float>(u - u0);
             const float px = std::min(std::max(x0 + dx * k, -16000.0f), 16000.0f);
