@@ -1,13 +1,19 @@
 #!/usr/bin/env python3
-"""Soak monitor: subscribes to the stabilized images, records latency
-(receive time - image stamp, on the ROS clock), samples the RSS of a
-process, and prints a summary. usage: soak_monitor.py PID SECONDS OUT.json"""
+"""Soak monitor: records latency two ways, both on the ROS clock divided by
+the playback rate (so in wall seconds): image stamp -> publication of the
+stabilized image as the node reports it (StabilizerState.latency_ms), and
+image stamp -> arrival of the stabilized image here (adds transport to
+another process and Python deserialization of the image); samples the RSS
+of a process and prints a summary.
+usage: soak_monitor.py PID SECONDS OUT.json [RATE=1]"""
 import json
 import sys
 import time
 
 import rospy
 from sensor_msgs.msg import Image
+
+from steadiface.msg import StabilizerState
 
 
 def rss_mb(pid):
@@ -20,17 +26,26 @@ def rss_mb(pid):
 
 def main():
     pid, seconds, out = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
+    rate = float(sys.argv[4]) if len(sys.argv) > 4 else 1.0
     rospy.init_node("soak_monitor", anonymous=True)
     lat = []
     frames = [0]
 
     def on_image(m):
         frames[0] += 1
-        d = (rospy.Time.now() - m.header.stamp).to_sec()
+        d = (rospy.Time.now() - m.header.stamp).to_sec() / rate
         if 0 <= d < 10:
             lat.append(d * 1000.0)
 
+    pub_lat, proc = [], []
+
+    def on_state(m):
+        proc.append(m.total_ms)
+        if m.latency_ms > 0:
+            pub_lat.append(m.latency_ms / rate)
+
     rospy.Subscriber("/camera/image_stabilized/image_raw", Image, on_image, queue_size=10)
+    rospy.Subscriber("/camera/state", StabilizerState, on_state, queue_size=100)
     samples = []
     t0 = time.time()
     while time.time() - t0 < seconds and not rospy.is_shutdown():
@@ -45,10 +60,18 @@ def main():
         den = sum((s[0] - mt) ** 2 for s in warm)
         slope = sum((s[0] - mt) * (s[1] - mr) for s in warm) / den * 3600.0 if den > 0 else 0.0
     lat.sort()
-    pct = lambda p: lat[min(len(lat) - 1, int(p * (len(lat) - 1) + 0.5))] if lat else float("nan")
-    res = {"seconds": seconds, "frames": frames[0], "rss_start_mb": samples[0][1] if samples else None,
+    pub_lat.sort()
+    proc.sort()
+
+    def pct(p, v=None):
+        v = lat if v is None else v
+        return v[min(len(v) - 1, int(p * (len(v) - 1) + 0.5))] if v else float("nan")
+    res = {"seconds": seconds, "rate": rate, "frames": frames[0], "rss_start_mb": samples[0][1] if samples else None,
            "rss_end_mb": samples[-1][1] if samples else None, "rss_slope_mb_per_h": slope,
-           "latency_p50_ms": pct(0.5), "latency_p99_ms": pct(0.99)}
+           "latency_p50_ms": pct(0.5), "latency_p99_ms": pct(0.99),
+           "publish_latency_p50_ms": pct(0.5, pub_lat), "publish_latency_p99_ms": pct(0.99, pub_lat),
+           "processing_p50_ms": pct(0.5, proc), "processing_p99_ms": pct(0.99, proc),
+           "states": len(pub_lat)}
     with open(out, "w") as f:
         json.dump(res, f, indent=1)
     print(json.dumps(res))

@@ -313,11 +313,16 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
         new sensor_msgs::CameraInfo(ToCameraInfo(frame.output_intrinsics, out_header)));
     sink_->PublishImage(img, info);
   }
+  const ros::Time published = sink_->Now();
   if (!passthrough) {
     std_msgs::Header lm_header = in_header;
     lm_header.frame_id = camera_frame;
     sink_->PublishLandmarks(ToMsg(frame.face, lm_header));
-    sink_->PublishState(ToMsg(frame, lm_header, extrapolated));
+    steadiface::StabilizerState state = ToMsg(frame, lm_header, extrapolated);
+    if (!published.isZero() && published >= in_header.stamp) {
+      state.latency_ms = (published - in_header.stamp).toSec() * 1e3;
+    }
+    sink_->PublishState(state);
     // TF, strictly increasing within an epoch.
     if (last_tf_stamp_.isZero() || in_header.stamp > last_tf_stamp_) {
       std::vector<geometry_msgs::TransformStamped> tf;

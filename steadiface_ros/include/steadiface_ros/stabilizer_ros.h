@@ -55,6 +55,7 @@ class StabilizerRos : public OutputSink {
   void Warn(const std::string& key, const std::string& text) override;
   void Error(const std::string& key, const std::string& text) override;
   void OnTimeJump() override;
+  ros::Time Now() const override { return ros::Time::now(); }
 
  private:
   void OnImage(const sensor_msgs::ImageConstPtr& image,

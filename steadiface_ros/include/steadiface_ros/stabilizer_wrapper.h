@@ -44,6 +44,9 @@ class OutputSink {
   /// keyed by time (the nodelet clears its TF buffer, which would otherwise
   /// refuse the new epoch's transforms as TF_OLD_DATA).
   virtual void OnTimeJump() {}
+  /// The clock the latency in `state` is measured on (the ROS clock in the
+  /// nodelet); zero (the default, offline) leaves latency_ms at 0.
+  virtual ros::Time Now() const { return ros::Time(); }
 };
 
 /// Counters behind the diagnostics, all since start.
