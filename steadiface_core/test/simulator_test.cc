@@ -280,6 +280,82 @@ TEST(PipelinePresetTest, RunWithACropSizedForRunning) {
   EXPECT_EQ(r.full.undefined_fraction, 0.0);
 }
 
+// The face leaves the frame sideways and comes back (issue: simulator,
+// events; issue: stabilizer, no face): the truth flags the frames, the
+// stabilizer fades to gyro-only while the face is out and back in after it
+// returns, with bounded per-frame weight steps and no undefined pixels.
+TEST(PipelinePresetTest, FaceLeavingAndReenteringFadesWithoutJumps) {
+  auto s = Make("walk", [](sim::SimulatorOptions* o) {
+    o->duration_s = 4.0;
+    o->face_out_start_s = 1.2;
+    o->face_out_end_s = 2.4;
+  });
+  int out_frames = 0;
+  for (int i = 0; i < s->num_frames(); ++i) out_frames += s->Truth(i).face_out ? 1 : 0;
+  EXPECT_FALSE(s->Truth(0).face_out);
+  EXPECT_FALSE(s->Truth(s->num_frames() - 1).face_out);
+  EXPECT_GT(out_frames, 20);
+  const PipelineOptions po = eval::OptionsFor(*s, eval::Method::kSteadiface);
+  CameraModel m;
+  ASSERT_TRUE(CameraModel::Create(s->intrinsics(), po.camera, &m).ok());
+  OutputGeometry og;
+  ASSERT_TRUE(OutputGeometry::Create(m, po.warp.output, &og).ok());
+  eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+  std::vector<StabilizerFrame> frames;
+  ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadiface, po, false, &card, &frames).ok());
+  ASSERT_EQ(static_cast<int>(frames.size()), s->num_frames());
+  double max_step = 0.0, min_fit_out = 1.0, max_fit_back = 0.0;
+  int used_while_out = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const double t = ToSeconds(frames[i].stamp - frames[0].stamp);
+    if (i > 0) max_step = std::max(max_step, std::abs(frames[i].factors.fit - frames[i - 1].factors.fit));
+    // Fully out of view (the 0.4 s ramp done) and 0.5 s later: faded out.
+    if (t > 1.6 + 0.5 && t < 2.4) min_fit_out = std::min(min_fit_out, frames[i].factors.fit);
+    if (t > 1.6 + 0.5 && t < 2.4 && frames[i].flags.face_used) ++used_while_out;
+    if (t > 3.3) max_fit_back = std::max(max_fit_back, frames[i].factors.fit);
+  }
+  std::cout << "[ face leaves ] " << out_frames << " frames out of view; w_f factor while out "
+            << min_fit_out << ", after return " << max_fit_back << ", max step " << max_step
+            << "\n";
+  EXPECT_LT(min_fit_out, 0.15);     // gyro-only while the face is away
+  EXPECT_GT(max_fit_back, 0.5);     // the face is back and used again
+  EXPECT_EQ(used_while_out, 0);
+  EXPECT_LT(max_step, 0.2);         // fades, never jumps
+  EXPECT_EQ(card.Compute().undefined_fraction, 0.0);
+}
+
+// A global brightness change mid-sequence (auto exposure): the face stays
+// tracked through it, and the head stays steadier than gyro-only.
+TEST(PipelinePresetTest, BrightnessChangeKeepsTheFace) {
+  auto s = Make("walk", [](sim::SimulatorOptions* o) { o->brightness_change_s = 1.5; });
+  int changed = 0;
+  for (int i = 0; i < s->num_frames(); ++i) changed += s->Truth(i).brightness_changed ? 1 : 0;
+  EXPECT_GT(changed, 10);
+  eval::Score full, gyro;
+  for (eval::Method method : {eval::Method::kGyroOnly, eval::Method::kSteadiface}) {
+    const PipelineOptions po = eval::OptionsFor(*s, method);
+    CameraModel m;
+    CameraModel::Create(s->intrinsics(), po.camera, &m);
+    OutputGeometry og;
+    OutputGeometry::Create(m, po.warp.output, &og);
+    eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+    std::vector<StabilizerFrame> frames;
+    ASSERT_TRUE(eval::RunMethod(*s, method, po, false, &card, &frames).ok());
+    (method == eval::Method::kSteadiface ? full : gyro) = card.Compute();
+    if (method == eval::Method::kSteadiface) {
+      int used_after = 0, after = 0;
+      for (size_t i = 0; i < frames.size(); ++i) {
+        if (ToSeconds(frames[i].stamp - frames[0].stamp) > 1.6) {
+          ++after;
+          used_after += frames[i].flags.face_used ? 1 : 0;
+        }
+      }
+      EXPECT_GT(used_after, 0.9 * after) << "face lost after the brightness change";
+    }
+  }
+  EXPECT_LT(full.head_jitter_px, 0.5 * gyro.head_jitter_px);
+}
+
 TEST(PipelinePresetTest, EveryPresetHasNoUndefinedPixels) {
   for (const std::string& p : {"still", "pan", "occlusion", "two_faces", "turn_away"}) {
     const PresetResult r = Score(p);
