@@ -100,7 +100,83 @@ def wait_for(pred, timeout):
     return pred()
 
 
+def rel_angle(live_state, row):
+    """Angle between the live state's R_v R_r^-1 and an offline trajectory
+    row's (independent of where each run's world frame starts)."""
+    class Q(object):
+        pass
+    qb, rb = Q(), Q()
+    qb.x, qb.y, qb.z, qb.w = (float(row[k]) for k in ("qx", "qy", "qz", "qw"))
+    rb.x, rb.y, rb.z, rb.w = (float(row[k]) for k in ("rqx", "rqy", "rqz", "rqw"))
+    rel_live = quat_to_R(live_state.virtual_rotation).dot(quat_to_R(live_state.real_rotation).T)
+    rel_bag = quat_to_R(qb).dot(quat_to_R(rb).T)
+    d = rel_live.dot(rel_bag.T)
+    return math.acos(max(-1.0, min(1.0, (np.trace(d) - 1.0) / 2.0)))
+
+
 class StabilizerTest(unittest.TestCase):
+    def check_bag_loop(self, c):
+        # rosbag play --loop --clock: /clock and every stamp jump back at the
+        # loop. After the reset, the second pass must reproduce a fresh start:
+        # the offline tool on the whole bag (itself equal to the live nodelet,
+        # equivalence.test), to 1e-6; TF strictly increasing within each pass.
+        import os
+        import subprocess
+        import tempfile
+        n_frames = sum(1 for _ in open(ARGS.truth)) - 1
+
+        def passes(states=None):
+            if states is None:
+                with c.lock:
+                    states = list(c.states)
+            out, cur, last = [], [], None
+            for st in states:
+                t = st.header.stamp.to_sec()
+                if last is not None and t < last - 1.0:
+                    out.append(cur)
+                    cur = []
+                cur.append(st)
+                last = t
+            out.append(cur)
+            return out
+        ok = wait_for(lambda: len(passes()) >= 3 or
+                      (len(passes()) == 2 and len(passes()[1]) >= n_frames), 150)
+        self.assertTrue(ok, "the second pass did not complete: passes %s" % [len(p) for p in passes()])
+        # One snapshot of states and TF, so both see the same passes.
+        with c.lock:
+            states = list(c.states)
+            tf = [t for t in c.tf if t.child_frame_id.endswith("_stabilized")]
+        p = passes(states)
+        second = {round(st.header.stamp.to_sec(), 3): st for st in p[1]}
+        bag = ARGS.truth[:-len(".truth.csv")]
+        out = os.path.join(tempfile.mkdtemp(), "traj.csv")
+        subprocess.check_call([ARGS.bag_tool, "--in", bag, "--params", ARGS.params,
+                               "--trajectory", out, "--quiet"])
+        worst, matched, rows = 0.0, 0, 0
+        with open(out) as f:
+            for r in csv.DictReader(f):
+                rows += 1
+                key = round(float(r["stamp"]), 3)
+                if key in second:
+                    matched += 1
+                    worst = max(worst, rel_angle(second[key], r))
+        # TF: strictly increasing within each pass (one backwards step per loop;
+        # the TF of a pass's first frame can precede its state in the snapshot).
+        backs = 0
+        for a, b in zip(tf, tf[1:]):
+            if b.header.stamp <= a.header.stamp:
+                backs += 1
+                self.assertLess(b.header.stamp.to_sec(), a.header.stamp.to_sec() - 1.0,
+                                "TF stamp not increasing within a pass")
+        diag = c.diag.get(ARGS.node.lstrip("/") + ": gyro")
+        print("bag loop: passes %s; second pass %d/%d frames, worst rotation difference to a "
+              "fresh start %.3g rad; TF steps back %d; gyro diagnostic %s" % (
+                  [len(x) for x in p], matched, rows, worst, backs, diag))
+        self.assertEqual(matched, rows, "the second pass lost frames")
+        self.assertLess(worst, 1e-6)
+        self.assertGreaterEqual(backs, 1)
+        self.assertLessEqual(backs, len(p))
+
     def check_equivalence(self, c):
         # The live nodelet and steadiface_bag on the same bag: same poses.
         import os
@@ -172,11 +248,14 @@ class StabilizerTest(unittest.TestCase):
         self.assertLess(worst_t, 1e-6)
 
     def test_stabilizer(self):
-        c = Collector(watch_input=not ARGS.equivalence)
+        c = Collector(watch_input=not (ARGS.equivalence or ARGS.bag_loop))
         node = ARGS.node
         dnode = node.lstrip("/")  # diagnostic_updater names drop the leading '/'
         if ARGS.equivalence:
             self.check_equivalence(c)
+            return
+        if ARGS.bag_loop:
+            self.check_bag_loop(c)
             return
         if ARGS.no_imu:
             self.assertTrue(wait_for(lambda: len(c.images) > 0, 40), "no image published without IMU")
@@ -255,6 +334,7 @@ if __name__ == "__main__":
     p.add_argument("--node", default="/camera/steadiface")
     p.add_argument("--no-imu", action="store_true")
     p.add_argument("--equivalence", action="store_true")
+    p.add_argument("--bag-loop", action="store_true")
     p.add_argument("--params", default="")
     p.add_argument("--bag-tool", default="steadiface_bag")
     ARGS, rest = p.parse_known_args(rospy.myargv()[1:])
