@@ -220,15 +220,7 @@ class StabilizerTest(unittest.TestCase):
                     continue
                 matched += 1
                 s = live[key]
-                class Q(object):
-                    pass
-                qb, rb = Q(), Q()
-                qb.x, qb.y, qb.z, qb.w = (float(r[k]) for k in ("qx", "qy", "qz", "qw"))
-                rb.x, rb.y, rb.z, rb.w = (float(r[k]) for k in ("rqx", "rqy", "rqz", "rqw"))
-                rel_live = quat_to_R(s.virtual_rotation).dot(quat_to_R(s.real_rotation).T)
-                rel_bag = quat_to_R(qb).dot(quat_to_R(rb).T)
-                d = rel_live.dot(rel_bag.T)
-                ang = math.acos(max(-1.0, min(1.0, (np.trace(d) - 1.0) / 2.0)))
+                ang = rel_angle(s, r)
                 if ang > 1e-6 and os.environ.get("SF_DEBUG"):
                     print("diff at", key, "idx", matched, "angle", ang, "w_fit", s.w_fit, r["w_fit"], "C", s.centre_c[0], r["cx"], "H", s.target_h[0], r["hx"], "speed", s.mean_angular_speed)
                 worst_angle = max(worst_angle, ang)

@@ -43,6 +43,33 @@ std::string RunCapture(const std::string& cmd) {
   return out;
 }
 
+// Runs `cmd` (an ffmpeg writing bgr24 frames of w x h to stdout) and hands
+// each frame to `sink`; `what` names the command in errors.
+Status ReadRawFrames(const std::string& cmd, int w, int h, const std::string& what,
+                     const std::function<Status(const cv::Mat&)>& sink) {
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return Status::Error("cannot start ffmpeg");
+  cv::Mat frame(h, w, CV_8UC3);
+  const size_t bytes = frame.total() * 3;
+  Status s = Status::Ok();
+  int frames = 0;
+  while (s.ok() && fread(frame.data, 1, bytes, p) == bytes) {
+    ++frames;
+    s = sink(frame);
+  }
+  if (!s.ok()) {
+    // Drain so ffmpeg can exit, then report the sink's error.
+    char buf[65536];
+    while (fread(buf, 1, sizeof(buf), p) > 0) {
+    }
+    pclose(p);
+    return s;
+  }
+  s = PcloseStatus(p, what);
+  if (s.ok() && frames == 0) return Status::Error(what + ": no frames");
+  return s;
+}
+
 }  // namespace
 
 const char* FfmpegMethodName(FfmpegMethod m) {
@@ -114,26 +141,7 @@ Status ReadVideo(const std::string& path, const std::function<Status(const cv::M
   if (height != nullptr) *height = h;
   const std::string cmd = "ffmpeg -hide_banner -loglevel error -nostdin -i " + Quote(path) +
                           " -f rawvideo -pix_fmt bgr24 -";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return Status::Error("cannot start ffmpeg");
-  cv::Mat frame(h, w, CV_8UC3);
-  const size_t bytes = frame.total() * 3;
-  Status s = Status::Ok();
-  int frames = 0;
-  while (s.ok() && fread(frame.data, 1, bytes, p) == bytes) {
-    ++frames;
-    s = sink(frame);
-  }
-  if (!s.ok()) {
-    char buf[65536];
-    while (fread(buf, 1, sizeof(buf), p) > 0) {
-    }
-    pclose(p);
-    return s;
-  }
-  s = PcloseStatus(p, "ffmpeg (decoding " + path + ")");
-  if (s.ok() && frames == 0) return Status::Error("'" + path + "' has no frames");
-  return s;
+  return ReadRawFrames(cmd, w, h, "ffmpeg (decoding " + path + ")", sink);
 }
 
 Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int width,
@@ -156,28 +164,8 @@ Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int wi
     filter = "format=yuv420p,deshake";
   }
   const std::string cmd = base + " -vf " + filter + " -f rawvideo -pix_fmt bgr24 -";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return Status::Error("cannot start ffmpeg");
-  cv::Mat frame(height, width, CV_8UC3);
-  const size_t bytes = frame.total() * 3;
-  Status s = Status::Ok();
-  int frames = 0;
-  while (fread(frame.data, 1, bytes, p) == bytes) {
-    ++frames;
-    s = sink(frame);
-    if (!s.ok()) break;
-  }
-  if (!s.ok()) {
-    // Drain so ffmpeg can exit, then report the sink's error.
-    char buf[65536];
-    while (fread(buf, 1, sizeof(buf), p) > 0) {
-    }
-    pclose(p);
-    return s;
-  }
-  s = PcloseStatus(p, std::string(FfmpegMethodName(method)));
+  const Status s = ReadRawFrames(cmd, width, height, FfmpegMethodName(method), sink);
   if (!s.ok()) return s;
-  if (frames == 0) return Status::Error(std::string(FfmpegMethodName(method)) + ": no frames");
   if (seconds != nullptr) {
     *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }

@@ -200,6 +200,19 @@ void Scorecard::Add(int index, const FrameWarp& w) {
   samples_.push_back(s);
 }
 
+std::vector<Eigen::Vector2d> Scorecard::LongestFiniteRun(const std::vector<Eigen::Vector2d>& x) {
+  std::vector<Eigen::Vector2d> run, best;
+  for (size_t i = 0; i <= x.size(); ++i) {
+    if (i < x.size() && x[i].allFinite()) {
+      run.push_back(x[i]);
+    } else {
+      if (run.size() > best.size()) best = run;
+      run.clear();
+    }
+  }
+  return best;
+}
+
 Score Scorecard::Compute() const {
   Score sc;
   sc.frames = static_cast<int>(samples_.size());
@@ -211,19 +224,7 @@ Score Scorecard::Compute() const {
   const double diag = std::hypot(out_w, out_h);
   // Jitter needs a contiguous series: each trajectory is scored on its
   // longest run of finite samples.
-  auto longest_run = [](const std::vector<Eigen::Vector2d>& x) {
-    std::vector<Eigen::Vector2d> run, best;
-    for (size_t i = 0; i <= x.size(); ++i) {
-      if (i < x.size() && x[i].allFinite()) {
-        run.push_back(x[i]);
-      } else {
-        if (run.size() > best.size()) best = run;
-        run.clear();
-      }
-    }
-    return best;
-  };
-  const std::vector<Eigen::Vector2d> head = longest_run(head_out_);
+  const std::vector<Eigen::Vector2d> head = LongestFiniteRun(head_out_);
   sc.head_jitter_px = HighPassRms(head, fps, options_.highpass_hz);
   sc.head_jitter_frac = sc.head_jitter_px / diag;
   sc.head_stability = Stability(head);
@@ -231,7 +232,7 @@ Score Scorecard::Compute() const {
   int nbg = 0;
   const size_t min_run = static_cast<size_t>(std::max(16.0, fps));  // >= 1 s
   for (const auto& traj : background_out_) {
-    const std::vector<Eigen::Vector2d> r = longest_run(traj);
+    const std::vector<Eigen::Vector2d> r = LongestFiniteRun(traj);
     if (r.size() < min_run) continue;
     bg += HighPassRms(r, fps, options_.highpass_hz);
     bg_stab += Stability(r);

@@ -10,20 +10,6 @@ namespace steadiface {
 namespace eval {
 namespace {
 
-// The longest run of finite samples (the exact scorecard scores the same way).
-std::vector<Eigen::Vector2d> LongestFiniteRun(const std::vector<Eigen::Vector2d>& x) {
-  std::vector<Eigen::Vector2d> run, best;
-  for (size_t i = 0; i <= x.size(); ++i) {
-    if (i < x.size() && x[i].allFinite()) {
-      run.push_back(x[i]);
-    } else {
-      if (run.size() > best.size()) best = run;
-      run.clear();
-    }
-  }
-  return best;
-}
-
 double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -122,7 +108,7 @@ Score VideoScorer::Compute() const {
   if (sc.frames == 0 || prev_gray_.empty()) return sc;
   const double diag = std::hypot(prev_gray_.cols, prev_gray_.rows);
   const size_t min_run = static_cast<size_t>(std::max(16.0, options_.fps));  // >= 1 s
-  const std::vector<Eigen::Vector2d> head = LongestFiniteRun(head_);
+  const std::vector<Eigen::Vector2d> head = Scorecard::LongestFiniteRun(head_);
   if (head.size() >= min_run) {
     sc.head_jitter_px = Scorecard::HighPassRms(head, options_.fps, options_.highpass_hz);
     sc.head_stability = Scorecard::Stability(head);
@@ -130,7 +116,7 @@ Score VideoScorer::Compute() const {
   sc.head_jitter_frac = sc.head_jitter_px / diag;
   // A lost background track breaks the integration: score the longest run
   // (after a break the trajectory restarts from NaN, so runs never mix).
-  const std::vector<Eigen::Vector2d> bg = LongestFiniteRun(background_);
+  const std::vector<Eigen::Vector2d> bg = Scorecard::LongestFiniteRun(background_);
   if (bg.size() >= min_run) {
     sc.background_jitter_px = Scorecard::HighPassRms(bg, options_.fps, options_.highpass_hz);
     sc.background_stability = Scorecard::Stability(bg);

@@ -95,6 +95,8 @@ class Scorecard {
                             double cutoff_hz);
   /// Liu et al. stability of a 2D trajectory's frame-to-frame motion.
   static double Stability(const std::vector<Eigen::Vector2d>& x);
+  /// The longest run of finite samples (jitter needs a contiguous series).
+  static std::vector<Eigen::Vector2d> LongestFiniteRun(const std::vector<Eigen::Vector2d>& x);
 
  private:
   bool MapToOutput(const FrameWarp& w, const Eigen::Vector2d& in_px,
