@@ -6,6 +6,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "steadiface_core/percentile.h"
+
 #include "steadiface_core/sim/landmark_sequence.h"
 #include "steadiface_core/stabilizer/stabilizer.h"
 
@@ -23,11 +25,6 @@ void BM_HeadSmoother(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_HeadSmoother);
-
-double Percentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
-}
 
 // One iteration = one whole sequence; per-frame figures as counters.
 void BM_StabilizerPerFrame(benchmark::State& state) {

@@ -12,6 +12,7 @@
 #include "steadiface_core/eval/ffmpeg_baseline.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/video_scorer.h"
+#include "steadiface_core/percentile.h"
 #include "test_util.h"
 
 namespace steadiface {
@@ -64,6 +65,17 @@ TEST(VideoScorerTest, StillVideoScoresZeroAndAKnownShakeScoresItsRms) {
   // What the path cannot see is reported as unknown.
   EXPECT_TRUE(std::isnan(s1.cropping));
   EXPECT_TRUE(std::isnan(s1.undefined_fraction));
+}
+
+TEST(PercentileTest, NearestRank) {
+  EXPECT_EQ(Percentile({}, 0.5), 0.0);
+  EXPECT_EQ(Percentile({3.0}, 0.99), 3.0);
+  EXPECT_EQ(Percentile({5, 1, 4, 2, 3}, 0.5), 3.0);
+  EXPECT_EQ(Percentile({5, 1, 4, 2, 3}, 0.0), 1.0);
+  EXPECT_EQ(Percentile({5, 1, 4, 2, 3}, 1.0), 5.0);
+  std::vector<double> v;
+  for (int i = 1; i <= 100; ++i) v.push_back(101 - i);
+  EXPECT_EQ(Percentile(v, 0.99), 99.0);  // rank round(0.99 * 99) = 98 -> 99
 }
 
 TEST(VideoScorerTest, RejectsBadOptionsAndFrames) {

@@ -32,6 +32,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "steadiface_core/eval/scorecard.h"
+#include "steadiface_core/percentile.h"
 #include "steadiface_core/so3.h"
 #include "steadiface_ros/msg_conversion.h"
 #include "steadiface_ros/params.h"
@@ -187,11 +188,7 @@ int Usage() {
   return 2;
 }
 
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
-}
+using steadiface::Percentile;
 
 // The scorecard's definition of jitter: > cutoff RMS, linear trend removed.
 double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps, double cutoff) {

@@ -1,5 +1,7 @@
 #include "steadiface_core/eval/scorecard.h"
 
+#include "steadiface_core/percentile.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,12 +13,6 @@
 namespace steadiface {
 namespace eval {
 namespace {
-
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
-}
 
 // Power spectrum of a real series (DFT), bins 0..n/2.
 std::vector<double> Power(const std::vector<double>& x) {

@@ -6,16 +6,10 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "steadiface_core/percentile.h"
+
 namespace steadiface {
 namespace eval {
-namespace {
-
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
 
 Status VideoScorer::Create(const CameraIntrinsics& intrinsics, const VideoScorerOptions& options,
                            std::unique_ptr<VideoScorer>* out) {
@@ -79,7 +73,7 @@ Status VideoScorer::Add(const cv::Mat& frame) {
     }
     if (static_cast<int>(dx.size()) >= options_.min_features) {
       if (!bg.allFinite()) bg.setZero();  // a new run after a lost track
-      bg += Eigen::Vector2d(Median(dx), Median(dy));
+      bg += Eigen::Vector2d(Percentile(dx, 0.5), Percentile(dy, 0.5));
     } else {
       ++untracked_pairs_;
       bg = Eigen::Vector2d(std::nan(""), std::nan(""));
