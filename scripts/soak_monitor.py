@@ -5,8 +5,11 @@ stabilized image as the node reports it (StabilizerState.latency_ms), and
 image stamp -> arrival of the stabilized image here (adds transport to
 another process and Python deserialization of the image); samples the RSS
 of a process and prints a summary.
-usage: soak_monitor.py PID SECONDS OUT.json [RATE=1]"""
+usage: soak_monitor.py PID SECONDS OUT.json [RATE=1]
+SOAK_NO_IMAGE_SUBSCRIBER=1: do not subscribe to the images (latency as the
+node reports it, without a Python consumer competing for the CPU)."""
 import json
+import os
 import sys
 import time
 
@@ -37,14 +40,21 @@ def main():
         if 0 <= d < 10:
             lat.append(d * 1000.0)
 
-    pub_lat, proc = [], []
+    pub_lat, proc, arrival, wait = [], [], [], []
 
     def on_state(m):
+        if frames[0] < 0 or os.environ.get("SOAK_NO_IMAGE_SUBSCRIBER") == "1":
+            frames[0] = max(frames[0], 0) + 1
         proc.append(m.total_ms)
         if m.latency_ms > 0:
             pub_lat.append(m.latency_ms / rate)
+            arrival.append(m.arrival_latency_ms / rate)
+            wait.append(m.gyro_wait_ms / rate)
 
-    rospy.Subscriber("/camera/image_stabilized/image_raw", Image, on_image, queue_size=10)
+    if os.environ.get("SOAK_NO_IMAGE_SUBSCRIBER") != "1":
+        rospy.Subscriber("/camera/image_stabilized/image_raw", Image, on_image, queue_size=10)
+    else:
+        frames[0] = -1  # counted from the state topic instead
     rospy.Subscriber("/camera/state", StabilizerState, on_state, queue_size=100)
     samples = []
     t0 = time.time()
@@ -62,6 +72,8 @@ def main():
     lat.sort()
     pub_lat.sort()
     proc.sort()
+    arrival.sort()
+    wait.sort()
 
     def pct(p, v=None):
         v = lat if v is None else v
@@ -70,6 +82,8 @@ def main():
            "rss_end_mb": samples[-1][1] if samples else None, "rss_slope_mb_per_h": slope,
            "latency_p50_ms": pct(0.5), "latency_p99_ms": pct(0.99),
            "publish_latency_p50_ms": pct(0.5, pub_lat), "publish_latency_p99_ms": pct(0.99, pub_lat),
+           "arrival_p50_ms": pct(0.5, arrival), "arrival_p99_ms": pct(0.99, arrival),
+           "gyro_wait_p50_ms": pct(0.5, wait), "gyro_wait_p99_ms": pct(0.99, wait),
            "processing_p50_ms": pct(0.5, proc), "processing_p99_ms": pct(0.99, proc),
            "states": len(pub_lat)}
     with open(out, "w") as f:

@@ -226,6 +226,7 @@ void StabilizerWrapper::Drain(const ros::Time& now, bool flush) {
 }
 
 void StabilizerWrapper::Process(const Pending& p, bool late) {
+  process_started_ = sink_->Now();
   ApplyPendingOptions();
   cv::Mat image;
   steadiface::Status s = ToCvImage(*p.image, &image);
@@ -321,6 +322,12 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
     steadiface::StabilizerState state = ToMsg(frame, lm_header, extrapolated);
     if (!published.isZero() && published >= in_header.stamp) {
       state.latency_ms = (published - in_header.stamp).toSec() * 1e3;
+      if (!p.received.isZero() && p.received >= in_header.stamp) {
+        state.arrival_latency_ms = (p.received - in_header.stamp).toSec() * 1e3;
+      }
+      if (!process_started_.isZero() && !p.received.isZero() && process_started_ >= p.received) {
+        state.gyro_wait_ms = (process_started_ - p.received).toSec() * 1e3;
+      }
     }
     sink_->PublishState(state);
     // TF, strictly increasing within an epoch.

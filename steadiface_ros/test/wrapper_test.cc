@@ -152,6 +152,44 @@ TEST(WrapperTest, CleanStreamIsStabilizedFrameByFrame) {
   for (size_t i = 1; i < stamps.size(); ++i) EXPECT_GT(stamps[i], stamps[i - 1]);
 }
 
+// Latency parts in `state` on the sink's clock: image arrival, waiting for
+// the gyro to cover the last row, publication (the test's clock does not
+// advance during processing). Offline (no clock) they stay 0.
+TEST(WrapperTest, StateReportsLatencyAndItsParts) {
+  struct ClockSink : public Sink {
+    ros::Time now;
+    ros::Time Now() const override { return now; }
+  } sink;
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  const Stream& s = TestStream();
+  size_t g = 0;
+  for (int i = 0; i < 10; ++i) {
+    const ros::Time stamp = s.images[i]->header.stamp;
+    // Gyro up to the first row only: the frame must wait.
+    while (g < s.imu.size() && s.imu[g].header.stamp <= stamp) w.OnImu(s.imu[g++]);
+    sink.now = stamp + ros::Duration(0.020);
+    w.OnImage(s.images[i], s.info, sink.now);
+    EXPECT_EQ(sink.states.size(), static_cast<size_t>(i)) << "processed before the gyro covered it";
+    sink.now = stamp + ros::Duration(0.030);
+    const ros::Time last_row = stamp + ros::Duration(s.readout + 0.006);
+    while (g < s.imu.size() && s.imu[g].header.stamp <= last_row) w.OnImu(s.imu[g++]);
+    ASSERT_EQ(sink.states.size(), static_cast<size_t>(i + 1));
+    const steadiface::StabilizerState& st = sink.states.back();
+    EXPECT_NEAR(st.arrival_latency_ms, 20.0, 1e-3);
+    EXPECT_NEAR(st.gyro_wait_ms, 10.0, 1e-3);
+    EXPECT_NEAR(st.latency_ms, 30.0, 1e-3);
+  }
+  Sink offline;
+  StabilizerWrapper w2(Options(), WrapperOptions(), &offline);
+  Feed(&w2, s, 0, 5);
+  ASSERT_FALSE(offline.states.empty());
+  for (const auto& st : offline.states) {
+    EXPECT_EQ(st.latency_ms, 0.0);
+    EXPECT_EQ(st.arrival_latency_ms, 0.0);
+    EXPECT_EQ(st.gyro_wait_ms, 0.0);
+  }
+}
+
 TEST(WrapperTest, ImuFaultsAreRejectedCountedAndHarmless) {
   Sink sink;
   StabilizerWrapper w(Options(), WrapperOptions(), &sink);

@@ -154,6 +154,7 @@ class StabilizerWrapper {
   ros::Time last_external_stamp_;
   ros::Time last_frame_stamp_;
   ros::Time last_tf_stamp_;
+  ros::Time process_started_;  // sink clock at the start of Process (latency parts)
   ros::Time last_imu_stamp_;
   bool have_last_imu_ = false;
   WrapperCounters counters_;
