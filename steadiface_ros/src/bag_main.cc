@@ -399,7 +399,7 @@ int main(int argc, char** argv) {
     cv::resize(right, right, left.size());
     cv::Mat both;
     cv::hconcat(left, right, both);
-    if (!video.isOpened()) {
+    if (!video_writer) {  // first frame: open (the writer thread owns `video` after)
       const double fps = 30.0;
       video.open(video_tmp, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps, both.size());
       if (!video.isOpened()) {
