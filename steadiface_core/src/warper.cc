@@ -169,11 +169,18 @@ void Warper::BuildMaps() {
           // interpolation-table index in map2. Far-out coordinates clamp
           // (they sample the black border either way).
           const float s = static_cast<float>(kInterTabSize);
+          constexpr float kClamp = 16000.0f;
+          // One pixel from its 1/32 px coordinates.
+          auto store = [out1, out2](int u, int32_t ix, int32_t iy) {
+            out1[2 * u] = static_cast<short>(ix >> kInterBits);
+            out1[2 * u + 1] = static_cast<short>(iy >> kInterBits);
+            out2[u] = static_cast<ushort>((iy & (kInterTabSize - 1)) * kInterTabSize +
+                                          (ix & (kInterTabSize - 1)));
+          };
           const float xe = x0 + dx * static_cast<float>(u1 - u0);
           const float ye = y0 + dy * static_cast<float>(u1 - u0);
-          const float lim = 16000.0f;
-          if (u1 >= u0 && std::abs(x0) < lim && std::abs(y0) < lim && std::abs(xe) < lim &&
-              std::abs(ye) < lim) {
+          if (u1 >= u0 && std::abs(x0) < kClamp && std::abs(y0) < kClamp &&
+              std::abs(xe) < kClamp && std::abs(ye) < kClamp) {
             // Fast path (the whole segment in range, so no clamping): the
             // 1/32 px coordinates are linear in u, so step them in integer
             // fixed point (10 more fractional bits; the drift over a cell of
@@ -186,12 +193,7 @@ void Warper::BuildMaps() {
             const int32_t DX = static_cast<int32_t>(std::lround(dx * f));
             const int32_t DY = static_cast<int32_t>(std::lround(dy * f));
             for (int u = u0; u <= u1; ++u) {
-              const int32_t ix = X >> kFrac;
-              const int32_t iy = Y >> kFrac;
-              out1[2 * u] = static_cast<short>(ix >> kInterBits);
-              out1[2 * u + 1] = static_cast<short>(iy >> kInterBits);
-              out2[u] = static_cast<ushort>((iy & (kInterTabSize - 1)) * kInterTabSize +
-                                            (ix & (kInterTabSize - 1)));
+              store(u, X >> kFrac, Y >> kFrac);
               X += DX;
               Y += DY;
             }
@@ -199,14 +201,9 @@ void Warper::BuildMaps() {
           }
           for (int u = u0; u <= u1; ++u) {
             const float k = static_cast<float>(u - u0);
-            const float px = std::min(std::max(x0 + dx * k, -16000.0f), 16000.0f);
-            const float py = std::min(std::max(y0 + dy * k, -16000.0f), 16000.0f);
-            const int ix = cvRound(px * s);
-            const int iy = cvRound(py * s);
-            out1[2 * u] = static_cast<short>(ix >> kInterBits);
-            out1[2 * u + 1] = static_cast<short>(iy >> kInterBits);
-            out2[u] = static_cast<ushort>((iy & (kInterTabSize - 1)) * kInterTabSize +
-                                          (ix & (kInterTabSize - 1)));
+            const float px = std::min(std::max(x0 + dx * k, -kClamp), kClamp);
+            const float py = std::min(std::max(y0 + dy * k, -kClamp), kClamp);
+            store(u, cvRound(px * s), cvRound(py * s));
           }
         } else {
           for (int u = u0; u <= u1; ++u) {
