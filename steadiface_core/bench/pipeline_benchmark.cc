@@ -60,7 +60,6 @@ void BM_PipelineFrame(benchmark::State& state) {
   po.warp.num_threads = static_cast<int>(state.range(2));
   std::unique_ptr<Pipeline> p;
   size_t g = 0, i = 0;
-  const auto& imu = seq.sim->imu();
   std::vector<double> face, stab, warp, total;
   // A fresh pipeline that has acquired the face on the first frame.
   auto restart = [&]() -> bool {
@@ -71,11 +70,7 @@ void BM_PipelineFrame(benchmark::State& state) {
   };
   auto feed = [&](size_t k, PipelineFrame* out) {
     const Time stamp = seq.sim->Truth(static_cast<int>(k)).stamp;
-    const Time need = p->LastRowTime(stamp);
-    while (g < imu.size() && (!p->GyroCovers(stamp) ||
-                              imu[g].stamp + FromSeconds(po.imu.imu_time_offset_s) <= need)) {
-      p->AddGyro(imu[g++]);
-    }
+    eval::FeedGyroForFrame(*seq.sim, stamp, po.imu.imu_time_offset_s, p.get(), &g);
     return p->ProcessFrame(seq.frames[k], stamp, nullptr, 0.0, out);
   };
   PipelineFrame out;

@@ -27,6 +27,17 @@ PipelineOptions OptionsFor(const sim::Simulator& sim, Method method) {
   return o;
 }
 
+void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_offset_s,
+                      Pipeline* pipeline, size_t* next) {
+  const auto& imu = sim.imu();
+  const Time need = pipeline->LastRowTime(stamp);
+  while (*next < imu.size() &&
+         (!pipeline->GyroCovers(stamp) ||
+          imu[*next].stamp + FromSeconds(imu_time_offset_s) <= need)) {
+    pipeline->AddGyro(imu[(*next)++]);
+  }
+}
+
 Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions& options,
                  bool render, Scorecard* card, std::vector<StabilizerFrame>* frames_out,
                  const std::function<Status(const cv::Mat&)>& on_output) {
@@ -49,18 +60,11 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
   Status s = Pipeline::Create(sim.intrinsics(), o, &p);
   if (!s.ok()) return s;
   size_t g = 0;
-  const auto& imu = sim.imu();
   cv::Mat frame;
   sim::SimTruth truth;
   for (int i = 0; i < sim.num_frames(); ++i) {
     const Time stamp = sim.Truth(i).stamp;
-    // IMU up to just past the frame's last row, as a live node would have.
-    const Time need = p->LastRowTime(stamp);
-    while (g < imu.size() &&
-           (!p->GyroCovers(stamp) ||
-            imu[g].stamp + FromSeconds(o.imu.imu_time_offset_s) <= need)) {
-      p->AddGyro(imu[g++]);
-    }
+    FeedGyroForFrame(sim, stamp, o.imu.imu_time_offset_s, p.get(), &g);
     if (method == Method::kSteadiface || render) {
       s = sim.Render(i, &frame, &truth);
       if (!s.ok()) return s;

@@ -23,6 +23,13 @@ const char* MethodName(Method m);
 /// offset) with the package defaults otherwise.
 PipelineOptions OptionsFor(const sim::Simulator& sim, Method method);
 
+/// Feeds the simulator's gyro samples from index `*next` on into `pipeline`
+/// until they cover the frame stamped `stamp` up to just past its last row,
+/// as a live node would have them (`imu_time_offset_s` as in the pipeline's
+/// options); advances `*next`.
+void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_offset_s,
+                      Pipeline* pipeline, size_t* next);
+
 /// Renders every frame, feeds the IMU and the frames through a Pipeline
 /// (render_output off unless `render`), and scores the warps. Fills
 /// `score` and `card` (for trajectories); `frames_out` (optional) receives
