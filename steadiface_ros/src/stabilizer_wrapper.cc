@@ -226,7 +226,7 @@ void StabilizerWrapper::Drain(const ros::Time& now, bool flush) {
 }
 
 void StabilizerWrapper::Process(const Pending& p, bool late) {
-  process_started_ = sink_->Now();
+  const ros::Time started = sink_->Now();
   ApplyPendingOptions();
   cv::Mat image;
   steadiface::Status s = ToCvImage(*p.image, &image);
@@ -266,7 +266,7 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
     ++counters_.passthrough;
     sink_->Error("no_imu", "no IMU data: publishing unstabilized frames");
     last_frame_stamp_ = p.image->header.stamp;
-    Publish(p, frame, image, false, true);
+    Publish(p, frame, image, false, true, started);
     return;
   }
   if (late) {
@@ -294,11 +294,12 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   }
   if (extrapolated) ++counters_.extrapolated;
   last_frame_stamp_ = p.image->header.stamp;
-  Publish(p, frame, image, extrapolated, false);
+  Publish(p, frame, image, extrapolated, false, started);
 }
 
 void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFrame& frame,
-                                const cv::Mat& input, bool extrapolated, bool passthrough) {
+                                const cv::Mat& input, bool extrapolated, bool passthrough,
+                                const ros::Time& started) {
   std_msgs::Header in_header = p.image->header;
   const std::string camera_frame =
       wrapper_options_.camera_frame.empty() ? in_header.frame_id : wrapper_options_.camera_frame;
@@ -325,8 +326,8 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
       if (!p.received.isZero() && p.received >= in_header.stamp) {
         state.arrival_latency_ms = (p.received - in_header.stamp).toSec() * 1e3;
       }
-      if (!process_started_.isZero() && !p.received.isZero() && process_started_ >= p.received) {
-        state.gyro_wait_ms = (process_started_ - p.received).toSec() * 1e3;
+      if (!started.isZero() && !p.received.isZero() && started >= p.received) {
+        state.gyro_wait_ms = (started - p.received).toSec() * 1e3;
       }
     }
     sink_->PublishState(state);
@@ -357,11 +358,10 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
       ++counters_.tf_skipped;
     }
     if (frame.stabilizer.has_target) {
-      const double f_v = pipeline_->camera_model().virtual_focal();
-      const Eigen::Vector3d ray =
-          Eigen::Vector3d((frame.stabilizer.H.x() - 0.5 - frame.stabilizer.t.x()) / f_v,
-                          (frame.stabilizer.H.y() - 0.5 - frame.stabilizer.t.y()) / f_v, 1.0)
-              .normalized();
+      // H's ray in the virtual camera: K_v(t)^-1 [H; 1].
+      const Eigen::Vector3d ray = (pipeline_->camera_model().VirtualK(frame.stabilizer.t).inverse() *
+                                   frame.stabilizer.H.homogeneous())
+                                      .normalized();
       if (ray.allFinite()) {
         geometry_msgs::PointStamped p;
         p.header = out_header;

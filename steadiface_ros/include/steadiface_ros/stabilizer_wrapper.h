@@ -133,8 +133,10 @@ class StabilizerWrapper {
   bool EnsurePipeline(const sensor_msgs::CameraInfo& info, const std::string& frame_id);
   void ResetAll(const char* why);
   void ApplyPendingOptions();
+  // `started`: the sink's clock when processing began (latency parts).
   void Publish(const Pending& p, const steadiface::PipelineFrame& frame,
-               const cv::Mat& input, bool extrapolated, bool passthrough);
+               const cv::Mat& input, bool extrapolated, bool passthrough,
+               const ros::Time& started);
 
   steadiface::PipelineOptions options_;
   const WrapperOptions wrapper_options_;
@@ -154,7 +156,6 @@ class StabilizerWrapper {
   ros::Time last_external_stamp_;
   ros::Time last_frame_stamp_;
   ros::Time last_tf_stamp_;
-  ros::Time process_started_;  // sink clock at the start of Process (latency parts)
   ros::Time last_imu_stamp_;
   bool have_last_imu_ = false;
   WrapperCounters counters_;
