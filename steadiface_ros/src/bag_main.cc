@@ -154,9 +154,9 @@ class AsyncVideoWriter {
   std::thread thread_;
 };
 
-// One decoded bag message.
+// One decoded bag message: exactly one pointer is set for the topics the
+// tool reads (none for a message whose type did not instantiate).
 struct BagItem {
-  std::string topic;  // normalized
   ros::Time time;
   sensor_msgs::ImuConstPtr imu;
   sensor_msgs::CameraInfoConstPtr info;
@@ -429,19 +429,21 @@ int main(int argc, char** argv) {
   }
   BoundedQueue<BagItem> read_queue(64);
   std::string read_error;
+  const std::string imu_topic = norm(a.imu_topic), info_topic = norm(a.info_topic),
+                    landmarks_topic = norm(a.landmarks_topic), image_topic = norm(a.image_topic);
   std::thread reader([&] {
     try {
       for (const rosbag::MessageInstance& m : view) {
         BagItem item;
-        item.topic = norm(m.getTopic());
+        const std::string topic = norm(m.getTopic());
         item.time = m.getTime();
-        if (item.topic == norm(a.imu_topic)) {
+        if (topic == imu_topic) {
           item.imu = m.instantiate<sensor_msgs::Imu>();
-        } else if (item.topic == norm(a.info_topic)) {
+        } else if (topic == info_topic) {
           item.info = m.instantiate<sensor_msgs::CameraInfo>();
-        } else if (item.topic == norm(a.landmarks_topic)) {
+        } else if (topic == landmarks_topic) {
           item.landmarks = m.instantiate<steadiface::FaceLandmarks>();
-        } else if (item.topic == norm(a.image_topic)) {
+        } else if (topic == image_topic) {
           item.image = m.instantiate<sensor_msgs::Image>();
         }
         if (!read_queue.Push(std::move(item))) break;
@@ -453,25 +455,20 @@ int main(int argc, char** argv) {
   });
   BagItem item;
   while (read_queue.Pop(&item)) {
-    const std::string& topic = item.topic;
-    if (topic == norm(a.imu_topic)) {
-      if (auto imu = item.imu) wrapper.OnImu(*imu);
-    } else if (topic == norm(a.info_topic)) {
-      if (auto info = item.info) {
-        in_info = *info;
-        have_in_info = true;
-        infos[info->header.stamp] = info;
-        while (infos.size() > 64) infos.erase(infos.begin());
-      }
-    } else if (topic == norm(a.landmarks_topic)) {
-      if (auto lm = item.landmarks) wrapper.OnLandmarks(*lm);
-    } else if (topic == norm(a.image_topic)) {
-      if (auto img = item.image) {
-        if (img->header.stamp.toSec() < a.start_stamp - 1e-6) continue;
-        if (!only.empty() && !only.count(std::llround(img->header.stamp.toSec() * 1e3))) continue;
-        waiting.push_back(img);
-        ++images_seen;
-      }
+    if (item.imu) {
+      wrapper.OnImu(*item.imu);
+    } else if (const auto& info = item.info) {
+      in_info = *info;
+      have_in_info = true;
+      infos[info->header.stamp] = info;
+      while (infos.size() > 64) infos.erase(infos.begin());
+    } else if (item.landmarks) {
+      wrapper.OnLandmarks(*item.landmarks);
+    } else if (const auto& img = item.image) {
+      if (img->header.stamp.toSec() < a.start_stamp - 1e-6) continue;
+      if (!only.empty() && !only.count(std::llround(img->header.stamp.toSec() * 1e3))) continue;
+      waiting.push_back(img);
+      ++images_seen;
     }
     // Pair images with the camera_info of the same stamp (either order).
     while (!waiting.empty()) {
