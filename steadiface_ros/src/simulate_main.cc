@@ -68,9 +68,6 @@ int main(int argc, char** argv) {
   steadiface::Status s = steadiface::sim::ApplyPreset(preset, &o);
   o.duration_s = duration;
   if (readout >= 0) o.readout_s = readout;
-  for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--no-face") o.render_face = false;  // presets keep it on
-  }
   std::unique_ptr<steadiface::sim::Simulator> sim;
   if (s.ok()) s = steadiface::sim::Simulator::Create(o, &sim);
   if (!s.ok()) {
