@@ -4,7 +4,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <vector>
 
 namespace steadiface {
 namespace eval {

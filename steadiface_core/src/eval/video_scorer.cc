@@ -75,7 +75,6 @@ Status VideoScorer::Add(const cv::Mat& frame) {
       if (!bg.allFinite()) bg.setZero();  // a new run after a lost track
       bg += Eigen::Vector2d(Percentile(dx, 0.5), Percentile(dy, 0.5));
     } else {
-      ++untracked_pairs_;
       bg = Eigen::Vector2d(std::nan(""), std::nan(""));
     }
   }

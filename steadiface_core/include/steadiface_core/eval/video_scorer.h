@@ -1,7 +1,6 @@
 #pragma once
 
 #include <memory>
-#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -34,8 +33,8 @@ struct VideoScorerOptions {
 /// vidstab, deshake, or any video file): the same metric definitions as
 /// `Scorecard`, measured on the output frames themselves.
 ///  - head: the landmark centre C of the face of interest (dlib, the
-///    pipeline's tracker without gyro), frames without a face linearly
-///    interpolated;
+///    pipeline's tracker without gyro), scored on the longest run of frames
+///    with a face (as the exact scorecard does with the true head);
 ///  - background: KLT tracks of corners outside the (enlarged) face box
 ///    between consecutive frames; the median displacement per frame pair is
 ///    integrated into one background trajectory.
@@ -69,7 +68,6 @@ class VideoScorer {
   bool prev_face_ = false;
   std::vector<Eigen::Vector2d> head_;
   std::vector<Eigen::Vector2d> background_;
-  int untracked_pairs_ = 0;
 };
 
 }  // namespace eval

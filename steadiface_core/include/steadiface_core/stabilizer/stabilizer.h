@@ -165,12 +165,12 @@ class Stabilizer {
   Eigen::Vector2d t_prev_prev_ = Eigen::Vector2d::Zero();
   bool has_H_ = false;
   Eigen::Vector2d H_prev_ = Eigen::Vector2d::Zero();
-  // Last usable face, as seen by a world-fixed camera (R = identity), for
-  // the fade-out after a loss.
   // Real rotation of the epoch's first frame: the world-fixed reference
   // camera for the variation measure and the held face (so results do not
   // depend on where gyro integration started).
   Eigen::Quaterniond R_reference_ = Eigen::Quaterniond::Identity();
+  // Last usable face, as seen by the reference camera (R_reference_), for
+  // the fade-out after a loss.
   bool has_held_face_ = false;
   FaceObservation held_face_;
 };
