@@ -33,6 +33,8 @@ def main():
     rospy.init_node("soak_monitor", anonymous=True)
     lat = []
     frames = [0]
+    # Without an image subscriber, frames are counted on the state topic.
+    count_states = os.environ.get("SOAK_NO_IMAGE_SUBSCRIBER") == "1"
 
     def on_image(m):
         frames[0] += 1
@@ -43,18 +45,16 @@ def main():
     pub_lat, proc, arrival, wait = [], [], [], []
 
     def on_state(m):
-        if frames[0] < 0 or os.environ.get("SOAK_NO_IMAGE_SUBSCRIBER") == "1":
-            frames[0] = max(frames[0], 0) + 1
+        if count_states:
+            frames[0] += 1
         proc.append(m.total_ms)
         if m.latency_ms > 0:
             pub_lat.append(m.latency_ms / rate)
             arrival.append(m.arrival_latency_ms / rate)
             wait.append(m.gyro_wait_ms / rate)
 
-    if os.environ.get("SOAK_NO_IMAGE_SUBSCRIBER") != "1":
+    if not count_states:
         rospy.Subscriber("/camera/image_stabilized/image_raw", Image, on_image, queue_size=10)
-    else:
-        frames[0] = -1  # counted from the state topic instead
     rospy.Subscriber("/camera/state", StabilizerState, on_state, queue_size=100)
     samples = []
     t0 = time.time()
