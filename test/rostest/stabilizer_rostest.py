@@ -213,9 +213,11 @@ class StabilizerTest(unittest.TestCase):
         # (the first gyro sample each received): the virtual camera relative
         # to the real one, R_v R_r^-1 (the published TF), and the offset t.
         worst_angle, worst_t, matched = 0.0, 0.0, 0
+        offline = []
         with open(out) as f:
             for r in csv.DictReader(f):
                 key = round(float(r["stamp"]), 3)
+                offline.append(key)
                 if key not in live:
                     continue
                 matched += 1
@@ -225,8 +227,6 @@ class StabilizerTest(unittest.TestCase):
                     print("diff at", key, "idx", matched, "angle", ang, "w_fit", s.w_fit, r["w_fit"], "C", s.centre_c[0], r["cx"], "H", s.target_h[0], r["hx"], "speed", s.mean_angular_speed)
                 worst_angle = max(worst_angle, ang)
                 worst_t = max(worst_t, abs(s.principal_offset[0] - float(r["tx"])), abs(s.principal_offset[1] - float(r["ty"])))
-        with open(out) as f:
-            offline = [round(float(r["stamp"]), 3) for r in csv.DictReader(f)]
         missing = [k for k in offline if k not in live]
         not_live = n_frames - len(live)
         print("equivalence: %d frames matched, worst rotation difference %.3g rad, offset %.3g; "
