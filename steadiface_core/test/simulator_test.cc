@@ -230,15 +230,13 @@ PresetResult Score(const std::string& preset, double crop_ratio = -1.0) {
   for (eval::Method method : {eval::Method::kNone, eval::Method::kGyroOnly, eval::Method::kSteadiface}) {
     PipelineOptions po = eval::OptionsFor(*s, method);
     if (crop_ratio >= 0.0) po.warp.output.crop_ratio = crop_ratio;
-    CameraModel m;
-    CameraModel::Create(s->intrinsics(), po.camera, &m);
-    OutputGeometry og;
-    OutputGeometry::Create(m, po.warp.output, &og);
-    eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
-    const Status st = eval::RunMethod(*s, method, po, false, &card, nullptr);
+    std::unique_ptr<eval::Scorecard> card;
+    Status st = eval::MakeScorecard(*s, po, &card);
+    if (st.ok()) st = eval::RunMethod(*s, method, po, false, card.get(), nullptr);
     EXPECT_TRUE(st.ok()) << st.message();
+    if (!st.ok()) continue;
     (method == eval::Method::kNone ? r.none : method == eval::Method::kGyroOnly ? r.gyro : r.full) =
-        card.Compute();
+        card->Compute();
   }
   std::cout << "[ " << preset << " ] head jitter none " << r.none.head_jitter_px << " / gyro-only "
             << r.gyro.head_jitter_px << " / steadiface " << r.full.head_jitter_px
@@ -296,13 +294,10 @@ TEST(PipelinePresetTest, FaceLeavingAndReenteringFadesWithoutJumps) {
   EXPECT_FALSE(s->Truth(s->num_frames() - 1).face_out);
   EXPECT_GT(out_frames, 20);
   const PipelineOptions po = eval::OptionsFor(*s, eval::Method::kSteadiface);
-  CameraModel m;
-  ASSERT_TRUE(CameraModel::Create(s->intrinsics(), po.camera, &m).ok());
-  OutputGeometry og;
-  ASSERT_TRUE(OutputGeometry::Create(m, po.warp.output, &og).ok());
-  eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+  std::unique_ptr<eval::Scorecard> card;
+  ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
   std::vector<StabilizerFrame> frames;
-  ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadiface, po, false, &card, &frames).ok());
+  ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadiface, po, false, card.get(), &frames).ok());
   ASSERT_EQ(static_cast<int>(frames.size()), s->num_frames());
   double max_step = 0.0, min_fit_out = 1.0, max_fit_back = 0.0;
   int used_while_out = 0;
@@ -321,7 +316,7 @@ TEST(PipelinePresetTest, FaceLeavingAndReenteringFadesWithoutJumps) {
   EXPECT_GT(max_fit_back, 0.5);     // the face is back and used again
   EXPECT_EQ(used_while_out, 0);
   EXPECT_LT(max_step, 0.2);         // fades, never jumps
-  EXPECT_EQ(card.Compute().undefined_fraction, 0.0);
+  EXPECT_EQ(card->Compute().undefined_fraction, 0.0);
 }
 
 // A global brightness change mid-sequence (auto exposure): the face stays
@@ -334,14 +329,11 @@ TEST(PipelinePresetTest, BrightnessChangeKeepsTheFace) {
   eval::Score full, gyro;
   for (eval::Method method : {eval::Method::kGyroOnly, eval::Method::kSteadiface}) {
     const PipelineOptions po = eval::OptionsFor(*s, method);
-    CameraModel m;
-    CameraModel::Create(s->intrinsics(), po.camera, &m);
-    OutputGeometry og;
-    OutputGeometry::Create(m, po.warp.output, &og);
-    eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+    std::unique_ptr<eval::Scorecard> card;
+    ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
     std::vector<StabilizerFrame> frames;
-    ASSERT_TRUE(eval::RunMethod(*s, method, po, false, &card, &frames).ok());
-    (method == eval::Method::kSteadiface ? full : gyro) = card.Compute();
+    ASSERT_TRUE(eval::RunMethod(*s, method, po, false, card.get(), &frames).ok());
+    (method == eval::Method::kSteadiface ? full : gyro) = card->Compute();
     if (method == eval::Method::kSteadiface) {
       int used_after = 0, after = 0;
       for (size_t i = 0; i < frames.size(); ++i) {

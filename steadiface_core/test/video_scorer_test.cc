@@ -106,17 +106,14 @@ TEST(VideoScorerTest, AgreesWithTheExactScorecardOnARenderedPreset) {
   auto s = Walk(640, 360, 3.0);
   for (eval::Method m : {eval::Method::kNone, eval::Method::kSteadiface}) {
     const PipelineOptions po = eval::OptionsFor(*s, m);
-    CameraModel model;
-    ASSERT_TRUE(CameraModel::Create(s->intrinsics(), po.camera, &model).ok());
-    OutputGeometry og;
-    ASSERT_TRUE(OutputGeometry::Create(model, po.warp.output, &og).ok());
-    eval::Scorecard card(*s, model, og, eval::ScorecardOptions());
+    std::unique_ptr<eval::Scorecard> card;
+    ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
     std::unique_ptr<eval::VideoScorer> v;
     ASSERT_TRUE(eval::VideoScorer::Create(s->intrinsics(), eval::VideoScorerOptions(), &v).ok());
-    const Status st = eval::RunMethod(*s, m, po, true, &card, nullptr,
+    const Status st = eval::RunMethod(*s, m, po, true, card.get(), nullptr,
                                       [&v](const cv::Mat& f) { return v->Add(f); });
     ASSERT_TRUE(st.ok()) << st.message();
-    const eval::Score exact = card.Compute(), approx = v->Compute();
+    const eval::Score exact = card->Compute(), approx = v->Compute();
     std::cout << "[ " << eval::MethodName(m) << " ] head exact " << exact.head_jitter_px
               << " approx " << approx.head_jitter_px << " px; background exact "
               << exact.background_jitter_px << " approx " << approx.background_jitter_px

@@ -200,19 +200,18 @@ int main(int argc, char** argv) {
                          : base == "gyro-only" ? Method::kGyroOnly : Method::kSteadiface;
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
-        steadiface::CameraModel model;
-        steadiface::CameraModel::Create(sim->intrinsics(), po.camera, &model);
-        steadiface::OutputGeometry og;
-        steadiface::OutputGeometry::Create(model, po.warp.output, &og);
-        steadiface::eval::Scorecard card(*sim, model, og, steadiface::eval::ScorecardOptions());
+        std::unique_ptr<steadiface::eval::Scorecard> card;
+        s = steadiface::eval::MakeScorecard(*sim, po, &card);
         steadiface::eval::VideoScorer* vsp = vs.get();
-        s = steadiface::eval::RunMethod(
-            *sim, m, po, render || video, &card, nullptr,
-            video ? std::function<steadiface::Status(const cv::Mat&)>(
-                        [vsp](const cv::Mat& f) { return vsp->Add(f); })
-                  : nullptr);
+        if (s.ok()) {
+          s = steadiface::eval::RunMethod(
+              *sim, m, po, render || video, card.get(), nullptr,
+              video ? std::function<steadiface::Status(const cv::Mat&)>(
+                          [vsp](const cv::Mat& f) { return vsp->Add(f); })
+                    : nullptr);
+        }
         if (s.ok() && !video) {
-          sc = card.Compute();
+          sc = card->Compute();
           for (const auto& st : sc.stage_ms) {
             if (st.first == "solver") solver = st.second.first;
             if (st.first == "face") face = st.second.first;
@@ -220,7 +219,7 @@ int main(int argc, char** argv) {
           std::ofstream csv(out_dir + "/traj_" + preset + "_" + name + ".csv");
           csv << "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
                  "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
-          for (const auto& p : card.samples()) {
+          for (const auto& p : card->samples()) {
             csv << p.t << "," << p.head_in.x() << "," << p.head_in.y() << "," << p.head_out.x()
                 << "," << p.head_out.y() << "," << p.head_valid << "," << p.background_out.x()
                 << "," << p.background_out.y() << "," << p.virtual_angle[0] << ","

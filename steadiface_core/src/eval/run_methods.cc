@@ -27,6 +27,18 @@ PipelineOptions OptionsFor(const sim::Simulator& sim, Method method) {
   return o;
 }
 
+Status MakeScorecard(const sim::Simulator& sim, const PipelineOptions& options,
+                     std::unique_ptr<Scorecard>* card) {
+  CameraModel model;
+  Status s = CameraModel::Create(sim.intrinsics(), options.camera, &model);
+  if (!s.ok()) return s;
+  OutputGeometry output;
+  s = OutputGeometry::Create(model, options.warp.output, &output);
+  if (!s.ok()) return s;
+  card->reset(new Scorecard(sim, model, output, ScorecardOptions()));
+  return Status::Ok();
+}
+
 void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_offset_s,
                       Pipeline* pipeline, size_t* next) {
   const auto& imu = sim.imu();

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,11 @@ const char* MethodName(Method m);
 /// Pipeline options matching a simulator (intrinsics, readout, IMU clock
 /// offset) with the package defaults otherwise.
 PipelineOptions OptionsFor(const sim::Simulator& sim, Method method);
+
+/// The scorecard for warps a pipeline with `options` produces on `sim` (its
+/// camera model and output geometry), with default scorecard options.
+Status MakeScorecard(const sim::Simulator& sim, const PipelineOptions& options,
+                     std::unique_ptr<Scorecard>* card);
 
 /// Feeds the simulator's gyro samples from index `*next` on into `pipeline`
 /// until they cover the frame stamped `stamp` up to just past its last row,
