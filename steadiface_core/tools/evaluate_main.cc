@@ -203,9 +203,10 @@ int main(int argc, char** argv) {
         std::unique_ptr<steadiface::eval::Scorecard> card;
         s = steadiface::eval::MakeScorecard(*sim, po, &card);
         steadiface::eval::VideoScorer* vsp = vs.get();
+        std::vector<steadiface::StabilizerFrame> stab_frames;
         if (s.ok()) {
           s = steadiface::eval::RunMethod(
-              *sim, m, po, render || video, card.get(), nullptr,
+              *sim, m, po, render || video, card.get(), &stab_frames,
               video ? std::function<steadiface::Status(const cv::Mat&)>(
                           [vsp](const cv::Mat& f) { return vsp->Add(f); })
                     : nullptr);
@@ -218,14 +219,28 @@ int main(int argc, char** argv) {
           }
           std::ofstream csv(out_dir + "/traj_" + preset + "_" + name + ".csv");
           csv << "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
-                 "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
-          for (const auto& p : card->samples()) {
+                 "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty,"
+                 "w_fit,protrusion_search_s,previous_warp\n";
+          // The stabilizer's own record (empty for "none"): the w_f in
+          // effect, how far the protrusion search moved towards the real
+          // pose (-1: it did not run) and whether the previous warp was reused.
+          const auto& samples = card->samples();
+          for (size_t i = 0; i < samples.size(); ++i) {
+            const auto& p = samples[i];
             csv << p.t << "," << p.head_in.x() << "," << p.head_in.y() << "," << p.head_out.x()
                 << "," << p.head_out.y() << "," << p.head_valid << "," << p.background_out.x()
                 << "," << p.background_out.y() << "," << p.virtual_angle[0] << ","
                 << p.virtual_angle[1] << "," << p.virtual_angle[2] << "," << p.real_angle[0]
                 << "," << p.real_angle[1] << "," << p.real_angle[2] << "," << p.offset.x()
-                << "," << p.offset.y() << "\n";
+                << "," << p.offset.y();
+            if (i < stab_frames.size()) {
+              const steadiface::StabilizerFrame& f = stab_frames[i];
+              csv << "," << f.weights.fit << ","
+                  << (f.flags.protrusion_search ? f.flags.protrusion_search_s : -1.0) << ","
+                  << f.flags.previous_warp << "\n";
+            } else {
+              csv << ",nan,nan,nan\n";  // no stabilizer (input)
+            }
           }
         }
       }
