@@ -217,6 +217,52 @@ TEST(ScorecardTest, AddedJitterRaisesTheScoreByTheExpectedAmount) {
   EXPECT_GT(sc.undefined_fraction, 0.6);
 }
 
+// A still camera with a moving head: the head moves against a still
+// background by the head's own motion. Holding the head (an image shift that
+// cancels it) moves the background by exactly that much; a global shake
+// moves both alike. The relative jitter is the same for all three warps, and
+// the background floor is 0 for the input and the whole relative jitter when
+// the head is held.
+TEST(ScorecardTest, RelativeJitterIsFixedByTheSceneAndBoundsTheBackground) {
+  auto s = Make("still");
+  CameraModel m;
+  ASSERT_TRUE(CameraModel::Create(s->intrinsics(), CameraModelOptions(), &m).ok());
+  OutputGeometry og;
+  ASSERT_TRUE(OutputGeometry::Create(m, OutputOptions(), &og).ok());
+  const Eigen::Vector2d head0 = s->Truth(0).head_px;
+  auto score = [&](auto shift_of_frame) {
+    eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+    for (int i = 0; i < s->num_frames(); ++i) {
+      eval::FrameWarp w;
+      w.kind = eval::FrameWarp::Kind::kHomography;
+      w.H.topRightCorner<2, 1>() = shift_of_frame(i);
+      card.Add(i, w);
+    }
+    return card.Compute();
+  };
+  const eval::Score input = score([](int) { return Eigen::Vector2d::Zero(); });
+  const eval::Score held = score([&](int i) -> Eigen::Vector2d {
+    return head0 - s->Truth(i).head_px;
+  });
+  const double a = 4.0;  // a 5 Hz global shake (an exact bin for 90 frames)
+  const eval::Score shaken = score([&](int i) -> Eigen::Vector2d {
+    return Eigen::Vector2d(a * std::sin(2 * M_PI * 5.0 * i / 30.0), 0.0);
+  });
+  ASSERT_GT(input.head_jitter_px, 5.0);
+  EXPECT_NEAR(input.background_jitter_px, 0.0, 1e-9);
+  EXPECT_NEAR(input.relative_jitter_px, input.head_jitter_px, 1e-6);
+  EXPECT_NEAR(input.background_floor_px, 0.0, 1e-6);
+
+  EXPECT_LT(held.head_jitter_px, 1e-6);
+  EXPECT_NEAR(held.relative_jitter_px, input.relative_jitter_px, 1e-6);
+  EXPECT_NEAR(held.background_jitter_px, input.head_jitter_px, 1e-6);
+  EXPECT_NEAR(held.background_floor_px, held.background_jitter_px, 1e-6);
+
+  EXPECT_NEAR(shaken.background_jitter_px, a / std::sqrt(2.0), 0.02 * a);
+  EXPECT_GT(shaken.head_jitter_px, input.head_jitter_px + 0.1);
+  EXPECT_NEAR(shaken.relative_jitter_px, input.relative_jitter_px, 1e-6);
+}
+
 // ---------- The full pipeline on rendered presets (issue: stabilizer) ----
 
 struct PresetResult {
@@ -242,6 +288,9 @@ PresetResult Score(const std::string& preset, double crop_ratio = -1.0) {
             << r.gyro.head_jitter_px << " / steadiface " << r.full.head_jitter_px
             << " px; background " << r.none.background_jitter_px << " / "
             << r.gyro.background_jitter_px << " / " << r.full.background_jitter_px
+            << " px; head-vs-background " << r.none.relative_jitter_px << " / "
+            << r.gyro.relative_jitter_px << " / " << r.full.relative_jitter_px
+            << " px; background floor " << r.full.background_floor_px
             << " px; undefined " << r.gyro.undefined_fraction << " / "
             << r.full.undefined_fraction << "\n";
   return r;
@@ -254,6 +303,29 @@ TEST(PipelinePresetTest, WalkBeatsGyroOnlyOnTheHeadAndKeepsTheBackground) {
   EXPECT_LE(r.gyro.background_jitter_px, 0.2 * r.none.background_jitter_px);
   EXPECT_LE(r.full.background_jitter_px, 0.85 * r.none.background_jitter_px);
   EXPECT_EQ(r.full.undefined_fraction, 0.0);
+}
+
+// One rotation and offset per frame moves the head and the far background
+// alike, so the head's jitter relative to the background is fixed by the
+// scene (up to the zoom and the rolling-shutter correction), and holding the
+// head costs the background at least that much. Steadiface pays little more
+// than that floor. On pan the person turns with the phone: the head moves
+// more against the background than the camera shakes, so no such warp can
+// hold the head to 0.3x the input's jitter and keep the background below the
+// input's.
+TEST(PipelinePresetTest, HoldingTheHeadCostsTheBackgroundLittleMoreThanGeometryRequires) {
+  const double zoom = 1.0 / (1.0 - 2.0 * OutputOptions().crop_ratio);
+  for (const std::string preset : {"walk", "pan"}) {
+    SCOPED_TRACE(preset);
+    const PresetResult r = Score(preset);
+    const double conserved = zoom * r.none.relative_jitter_px;
+    EXPECT_NEAR(r.gyro.relative_jitter_px, conserved, 0.12 * conserved);
+    EXPECT_NEAR(r.full.relative_jitter_px, conserved, 0.12 * conserved);
+    EXPECT_LE(r.full.background_jitter_px, 1.25 * r.full.background_floor_px);
+    if (preset == "pan") {
+      EXPECT_GT(conserved - 0.3 * r.none.head_jitter_px, r.none.background_jitter_px);
+    }
+  }
 }
 
 TEST(PipelinePresetTest, RunWithTheRealGyroTrace) {

@@ -106,9 +106,10 @@ int main(int argc, char** argv) {
        << height << "],\n  \"seed\": " << seed << ",\n  \"ffmpeg\": \""
        << (have_ffmpeg ? ffmpeg_version : "") << "\",\n  \"results\": [\n";
   std::cout << "| preset | method | head jitter px | head jitter %diag | background jitter px"
+               " | head-vs-bg jitter px | bg floor px"
                " | head stability | bg stability | cropping | distortion | undefined frames |"
                " solver p50 ms | face p50 ms | scoring |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   bool first = true;
   int failures = 0;
   auto fmt = [](const char* f, double v) {
@@ -257,6 +258,8 @@ int main(int argc, char** argv) {
       std::cout << "| " << preset << " | " << name << " | " << fmt("%.2f", sc.head_jitter_px)
                 << " | " << fmt("%.3f", 100 * sc.head_jitter_frac) << " | "
                 << fmt("%.2f", sc.background_jitter_px) << " | "
+                << fmt("%.2f", sc.relative_jitter_px) << " | "
+                << fmt("%.2f", sc.background_floor_px) << " | "
                 << fmt("%.2f", sc.head_stability) << " | "
                 << fmt("%.2f", sc.background_stability) << " | " << fmt("%.2f", sc.cropping)
                 << " | " << fmt("%.3f", sc.distortion) << " | "
@@ -268,6 +271,8 @@ int main(int argc, char** argv) {
            << ", \"head_jitter_frac\": " << jnum(sc.head_jitter_frac)
            << ", \"background_jitter_px\": " << jnum(sc.background_jitter_px)
            << ", \"background_jitter_frac\": " << jnum(sc.background_jitter_frac)
+           << ", \"relative_jitter_px\": " << jnum(sc.relative_jitter_px)
+           << ", \"background_floor_px\": " << jnum(sc.background_floor_px)
            << ", \"head_stability\": " << jnum(sc.head_stability)
            << ", \"background_stability\": " << jnum(sc.background_stability)
            << ", \"cropping\": " << jnum(sc.cropping) << ", \"distortion\": " << jnum(sc.distortion)

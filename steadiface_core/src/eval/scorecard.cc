@@ -235,6 +235,33 @@ Score Scorecard::Compute() const {
     ++nbg;
   }
   sc.background_jitter_px = nbg ? bg / nbg : NAN;
+  // Head relative to each background point, on the longest run of frames
+  // where both are in view.
+  double rel = 0.0, floor = 0.0;
+  int nrel = 0;
+  for (const auto& traj : background_out_) {
+    // Longest run [begin, end) of frames with both in view.
+    size_t begin = 0, end = 0;
+    for (size_t i = 0, start = 0; i <= traj.size(); ++i) {
+      const bool both = i < traj.size() && i < head_out_.size() && traj[i].allFinite() &&
+                        head_out_[i].allFinite();
+      if (both) continue;
+      if (i - start > end - begin) begin = start, end = i;
+      start = i + 1;
+    }
+    if (end - begin < min_run) continue;
+    std::vector<Eigen::Vector2d> h, d;
+    for (size_t i = begin; i < end; ++i) {
+      h.push_back(head_out_[i]);
+      d.push_back(head_out_[i] - traj[i]);
+    }
+    const double j_rel = HighPassRms(d, fps, options_.highpass_hz);
+    rel += j_rel;
+    floor += std::max(0.0, j_rel - HighPassRms(h, fps, options_.highpass_hz));
+    ++nrel;
+  }
+  sc.relative_jitter_px = nrel ? rel / nrel : NAN;
+  sc.background_floor_px = nrel ? floor / nrel : NAN;
   sc.background_jitter_frac = sc.background_jitter_px / diag;
   sc.background_stability = nbg ? bg_stab / nbg : NAN;
   sc.cropping = pose ? std::pow(1.0 - 2.0 * output_.crop_ratio(), 2.0) : 1.0;

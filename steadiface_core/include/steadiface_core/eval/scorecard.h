@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,19 @@ struct Score {
   double head_jitter_px = 0.0, head_jitter_frac = 0.0;
   /// The same for far-background points (mean over the points).
   double background_jitter_px = 0.0, background_jitter_frac = 0.0;
+  /// Jitter of the head relative to the background: the high-pass RMS of
+  /// head_out - background_out, per background point over its longest run
+  /// of frames with both in view, mean over the points [output px]. One
+  /// rotation and offset per frame moves the head and the far background
+  /// alike, so no such warp can change this much: it is about the input's
+  /// value times the output zoom (the head's own motion and the camera's
+  /// translation, i.e. parallax). NaN without such a run.
+  double relative_jitter_px = NAN;
+  /// The least background jitter any output with this head jitter can have,
+  /// by the triangle inequality J(b) >= J(h - b) - J(h) per point on the same
+  /// frames (mean over the points) [output px]. Holding the head still
+  /// costs at least this much background steadiness. NaN as above.
+  double background_floor_px = NAN;
   /// Liu et al. 2013 stability: energy in the 2nd-6th lowest frequency bins
   /// of the frame-to-frame motion over its total energy, excluding DC
   /// (1 = perfectly smooth), for the head and the background.
