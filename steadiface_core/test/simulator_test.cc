@@ -269,9 +269,12 @@ struct PresetResult {
   eval::Score none, gyro, full;
 };
 
-// `crop_ratio` < 0: the package default.
-PresetResult Score(const std::string& preset, double crop_ratio = -1.0) {
-  auto s = Make(preset);
+// `crop_ratio` < 0: the package default; `duration_s` < 0: the simulator's.
+PresetResult Score(const std::string& preset, double crop_ratio = -1.0,
+                   double duration_s = -1.0) {
+  auto s = Make(preset, [duration_s](sim::SimulatorOptions* o) {
+    if (duration_s > 0.0) o->duration_s = duration_s;
+  });
   PresetResult r;
   for (eval::Method method : {eval::Method::kNone, eval::Method::kGyroOnly, eval::Method::kSteadiface}) {
     PipelineOptions po = eval::OptionsFor(*s, method);
@@ -329,25 +332,33 @@ TEST(PipelinePresetTest, HoldingTheHeadCostsTheBackgroundLittleMoreThanGeometryR
 }
 
 TEST(PipelinePresetTest, RunWithTheRealGyroTrace) {
-  // The recorded running shake exceeds what a 10 % crop can absorb; the
-  // honest bar here is half of gyro-only's head jitter.
-  const PresetResult r = Score("run");
-  EXPECT_LE(r.full.head_jitter_px, 0.6 * r.gyro.head_jitter_px);
-  EXPECT_LE(r.full.head_jitter_px, 0.6 * r.none.head_jitter_px);
+  // The whole recorded running trace (9.9 s) at the default (the paper's)
+  // 15 % crop: the issue's bars hold (measured 0.21x the input's and 0.14x
+  // gyro-only's head jitter). Gyro-only alone cannot follow the shake: its
+  // virtual camera sits on the crop's bound, and the zoom makes it worse
+  // than the input.
+  const PresetResult r = Score("run", -1.0, 9.8);
+  EXPECT_LE(r.full.head_jitter_px, 0.3 * r.none.head_jitter_px);
+  EXPECT_LE(r.full.head_jitter_px, 0.5 * r.gyro.head_jitter_px);
+  EXPECT_LE(r.full.background_jitter_px, 0.6 * r.none.background_jitter_px);
   EXPECT_EQ(r.full.undefined_fraction, 0.0);
   EXPECT_EQ(r.gyro.undefined_fraction, 0.0);
 }
 
-TEST(PipelinePresetTest, RunWithACropSizedForRunning) {
-  // With a 20 % crop per side (what running footage needs; FVS uses 20 %)
-  // the issue's bars hold: at most 0.3x the input's and 0.5x gyro-only's
-  // head jitter (measured 0.20x and 0.12x). Gyro-only alone still cannot
-  // follow the recorded shake.
-  const PresetResult r = Score("run", 0.2);
-  EXPECT_LE(r.full.head_jitter_px, 0.3 * r.none.head_jitter_px);
-  EXPECT_LE(r.full.head_jitter_px, 0.5 * r.gyro.head_jitter_px);
-  EXPECT_LT(r.full.background_jitter_px, 0.6 * r.none.background_jitter_px);
-  EXPECT_EQ(r.full.undefined_fraction, 0.0);
+TEST(PipelinePresetTest, ALargerCropRemovesMoreOfTheRunningShake) {
+  // The crop margin bounds what any warp can remove; on the running trace's
+  // first 3 s (one 0.12 rad tilt larger than a 10 % margin) the head jitter
+  // falls as the crop grows (measured 12.9 / 7.6 / 4.9 px at 10 / 15 / 20 %,
+  // input 24.7 px).
+  double previous = 1e9;
+  for (double crop : {0.1, 0.15, 0.2}) {
+    SCOPED_TRACE(crop);
+    const PresetResult r = Score("run", crop);
+    EXPECT_LT(r.full.head_jitter_px, 0.8 * previous);
+    EXPECT_LE(r.full.head_jitter_px, 0.55 * r.none.head_jitter_px);
+    EXPECT_EQ(r.full.undefined_fraction, 0.0);
+    previous = r.full.head_jitter_px;
+  }
 }
 
 // The face leaves the frame sideways and comes back (issue: simulator,

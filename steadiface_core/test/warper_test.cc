@@ -431,7 +431,9 @@ namespace {
 TEST(DebugOverlayTest, DrawsLandmarksCentreTargetAndFootprint) {
   const CameraIntrinsics k = IntrinsicsFromHorizontalFov(640, 480, 1.1);
   const CameraModel m = Model(k);
-  auto w = MakeWarper(m, WarpOptions());
+  WarpOptions wo;
+  wo.output.crop_ratio = 0.1;
+  auto w = MakeWarper(m, wo);
   const cv::Mat input(480, 640, CV_8UC1, cv::Scalar(128));
   FaceInfo face;
   face.valid = true;
