@@ -333,14 +333,14 @@ TEST(PipelinePresetTest, HoldingTheHeadCostsTheBackgroundLittleMoreThanGeometryR
 
 TEST(PipelinePresetTest, RunWithTheRealGyroTrace) {
   // The whole recorded running trace (9.9 s) at the default (the paper's)
-  // 15 % crop: the bars hold (measured 0.21x the input's and 0.14x
-  // gyro-only's head jitter). Gyro-only alone cannot follow the shake: its
-  // virtual camera sits on the crop's bound, and the zoom makes it worse
-  // than the input.
+  // 15 % crop: the bars hold (measured: steadiface's head jitter
+  // 0.17x the input's and 0.31x gyro-only's; gyro-only removes 59 % of the
+  // background jitter, steadiface 59 %).
   const PresetResult r = Score("run", -1.0, 9.8);
   EXPECT_LE(r.full.head_jitter_px, 0.3 * r.none.head_jitter_px);
   EXPECT_LE(r.full.head_jitter_px, 0.5 * r.gyro.head_jitter_px);
-  EXPECT_LE(r.full.background_jitter_px, 0.6 * r.none.background_jitter_px);
+  EXPECT_LE(r.gyro.background_jitter_px, 0.5 * r.none.background_jitter_px);
+  EXPECT_LE(r.full.background_jitter_px, 0.5 * r.none.background_jitter_px);
   EXPECT_EQ(r.full.undefined_fraction, 0.0);
   EXPECT_EQ(r.gyro.undefined_fraction, 0.0);
 }
@@ -348,7 +348,7 @@ TEST(PipelinePresetTest, RunWithTheRealGyroTrace) {
 TEST(PipelinePresetTest, ALargerCropRemovesMoreOfTheRunningShake) {
   // The crop margin bounds what any warp can remove; on the running trace's
   // first 3 s (one 0.12 rad tilt larger than a 10 % margin) the head jitter
-  // falls as the crop grows (measured 12.9 / 7.6 / 4.9 px at 10 / 15 / 20 %,
+  // falls as the crop grows (measured 12.4 / 8.0 / 4.4 px at 10 / 15 / 20 %,
   // input 24.7 px).
   double previous = 1e9;
   for (double crop : {0.1, 0.15, 0.2}) {

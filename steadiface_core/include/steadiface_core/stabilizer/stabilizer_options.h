@@ -16,8 +16,10 @@ struct StabilizerWeights {
   double follow = 0.5;
   /// w_r,C0: rotation smoothness, C0 part of E_r [-].
   double rotation_c0 = 10.0;
-  /// w_r,C1: rotation smoothness, C1 part of E_r [-].
-  double rotation_c1 = 40.0;
+  /// w_r,C1: rotation smoothness, C1 part of E_r [-]. Heavier than this
+  /// carries the virtual camera's momentum past the real camera's swings on
+  /// strong shake (running), so gyro-only overshoots them.
+  double rotation_c1 = 10.0;
   /// w_t,C0: principal offset smoothness, C0 part of E_t [-].
   double translation_c0 = 20.0;
   /// w_t,C1: principal offset smoothness, C1 part of E_t [-].
@@ -29,8 +31,10 @@ struct StabilizerWeights {
 /// Shapes of individual terms.
 struct TermOptions {
   /// E_d: angle between virtual and real camera below which the logistic
-  /// makes the penalty ~0 [rad].
-  double distortion_threshold_rad = 0.08;
+  /// makes the penalty ~0 [rad]. About what the default 15 % crop admits at
+  /// its edges; lower, E_d drags the virtual camera along the running shake
+  /// before the crop is used up.
+  double distortion_threshold_rad = 0.15;
   /// E_d: logistic slope [1/rad].
   double distortion_slope = 150.0;
   /// E_p: α, the tolerated protrusion [normalized units, fraction of width].
