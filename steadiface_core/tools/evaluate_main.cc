@@ -4,7 +4,9 @@
 //
 //   steadiface_evaluate --data test/data --out out/eval
 //       [--presets walk,run] [--methods none,gyro-only,steadiface,...]
-//       [--duration 3] [--size 640x360] [--seed 1] [--render]
+//       [--duration S] [--size 640x360] [--seed 1] [--render]
+// Without --duration every preset runs 3 s, except that a preset replaying
+// a recorded gyro trace (run) runs the whole trace once.
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -52,7 +54,7 @@ int main(int argc, char** argv) {
   std::string data, out_dir;
   std::vector<std::string> presets = steadiface::sim::PresetNames();
   std::vector<std::string> methods;  // empty: the default set
-  double duration = 3.0;
+  double duration = NAN;  // NaN: 3 s, a recorded trace's whole length
   int width = 640, height = 360;
   uint64_t seed = 1;
   bool render = false;
@@ -102,7 +104,12 @@ int main(int argc, char** argv) {
   }
   mkdir(out_dir.c_str(), 0755);
   std::ofstream json(out_dir + "/report.json");
-  json << "{\n  \"duration_s\": " << duration << ",\n  \"size\": [" << width << ", "
+  auto jnum = [](double v) {
+    std::ostringstream o;
+    if (std::isfinite(v)) o << v; else o << "null";
+    return o.str();
+  };
+  json << "{\n  \"duration_s\": " << jnum(duration) << ",\n  \"size\": [" << width << ", "
        << height << "],\n  \"seed\": " << seed << ",\n  \"ffmpeg\": \""
        << (have_ffmpeg ? ffmpeg_version : "") << "\",\n  \"results\": [\n";
   std::cout << "| preset | method | head jitter px | head jitter %diag | background jitter px"
@@ -118,21 +125,21 @@ int main(int argc, char** argv) {
     std::snprintf(b, sizeof(b), f, v);
     return std::string(b);
   };
-  auto jnum = [](double v) {
-    std::ostringstream o;
-    if (std::isfinite(v)) o << v; else o << "null";
-    return o.str();
-  };
   for (const std::string& preset : presets) {
     steadiface::sim::SimulatorOptions so;
     so.data_dir = data;
-    so.duration_s = duration;
+    so.duration_s = std::isfinite(duration) ? duration : 3.0;
     so.width = width;
     so.height = height;
     so.seed = seed;
     steadiface::Status s = steadiface::sim::ApplyPreset(preset, &so);
     std::unique_ptr<steadiface::sim::Simulator> sim;
     if (s.ok()) s = steadiface::sim::Simulator::Create(so, &sim);
+    if (s.ok() && !std::isfinite(duration) && sim->real_gyro_span_s() > so.duration_s) {
+      // The whole recorded trace once (a 3 s slice of it is a poor sample).
+      so.duration_s = std::floor(10.0 * sim->real_gyro_span_s()) / 10.0;
+      s = steadiface::sim::Simulator::Create(so, &sim);
+    }
     if (!s.ok()) {
       std::cerr << "preset " << preset << ": " << s.message() << "\n";
       ++failures;
@@ -265,8 +272,8 @@ int main(int argc, char** argv) {
                 << " | " << fmt("%.3f", sc.distortion) << " | "
                 << fmt("%.1f%%", 100 * sc.undefined_fraction) << " | " << fmt("%.3f", solver)
                 << " | " << fmt("%.2f", face) << " | " << scoring << " |" << std::endl;
-      json << (first ? "" : ",\n") << "    {\"preset\": \"" << preset << "\", \"method\": \""
-           << name << "\", \"scoring\": \"" << scoring << "\", \"frames\": " << sc.frames
+      json << (first ? "" : ",\n") << "    {\"preset\": \"" << preset
+           << "\", \"duration_s\": " << so.duration_s << ", \"method\": \"" << name << "\", \"scoring\": \"" << scoring << "\", \"frames\": " << sc.frames
            << ", \"head_jitter_px\": " << jnum(sc.head_jitter_px)
            << ", \"head_jitter_frac\": " << jnum(sc.head_jitter_frac)
            << ", \"background_jitter_px\": " << jnum(sc.background_jitter_px)

@@ -107,6 +107,9 @@ class Simulator {
                        std::unique_ptr<Simulator>* out);
 
   int num_frames() const { return num_frames_; }
+  /// Length of the recorded gyro trace a real-gyro preset (run) replays [s];
+  /// 0 without one. Longer sequences play it forwards, then backwards.
+  double real_gyro_span_s() const { return real_gyro_span_s_; }
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }
   const RowTiming& timing() const { return timing_; }
   /// Gyro samples as the IMU reports them (camera axes, IMU clock).
