@@ -189,18 +189,17 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Num("camera/row_time_offset", &po->shutter.row_time_offset_s, -0.5, 0.5);
   r.Num("camera/virtual_focal_scale", &po->camera.virtual_focal_scale, 0.25, 4.0);
   // IMU.
-  std::vector<double> q;
+  const Eigen::Quaterniond& q0 = po->imu.R_cam_imu;
+  std::vector<double> q = {q0.x(), q0.y(), q0.z(), q0.w()};
   r.Vec("imu/R_cam_imu", &q);
-  if (!q.empty()) {
-    if (q.size() != 4) {
-      r.Error("parameter 'imu/R_cam_imu' must be a quaternion [x, y, z, w]");
+  if (q.size() != 4) {
+    r.Error("parameter 'imu/R_cam_imu' must be a quaternion [x, y, z, w]");
+  } else {
+    const Eigen::Quaterniond e(q[3], q[0], q[1], q[2]);
+    if (!(e.norm() > 0.5 && e.norm() < 2.0)) {
+      r.Error("parameter 'imu/R_cam_imu' must be a unit quaternion [x, y, z, w]");
     } else {
-      Eigen::Quaterniond e(q[3], q[0], q[1], q[2]);
-      if (!(e.norm() > 0.5 && e.norm() < 2.0)) {
-        r.Error("parameter 'imu/R_cam_imu' must be a unit quaternion [x, y, z, w]");
-      } else {
-        po->imu.R_cam_imu = e.normalized();
-      }
+      po->imu.R_cam_imu = e.normalized();
     }
   }
   r.Num("imu/time_offset", &po->imu.imu_time_offset_s, -1.0, 1.0);

@@ -27,7 +27,14 @@ enum class LandmarkSource {
 struct PipelineOptions {
   CameraModelOptions camera;
   RollingShutterOptions shutter;
-  OrientationTimelineOptions imu;
+  /// The gyro timeline. Unlike a bare timeline, a stream may extrapolate the
+  /// gyro up to 50 ms past its newest sample: a live node's late frames
+  /// (late_frame_policy "extrapolate") need it.
+  OrientationTimelineOptions imu = [] {
+    OrientationTimelineOptions o;
+    o.max_extrapolation_s = 0.05;
+    return o;
+  }();
   LandmarkSource landmark_source = LandmarkSource::kDlib;
   FaceTrackerOptions face;
   StabilizerOptions stabilizer;

@@ -1,0 +1,107 @@
+// config/default.yaml and config/Steadiface.cfg restate the core's option
+// defaults for users; these tests keep the three in step, and check that
+// LoadOptions rejects bad values with a message naming the key.
+#include "steadiface_ros/params.h"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <dynamic_reconfigure/Config.h>
+#include <gtest/gtest.h>
+
+namespace steadiface_ros {
+namespace {
+
+const std::string kDefaultYaml = std::string(STEADIFACE_CONFIG_DIR) + "/default.yaml";
+
+// Reads through another source and records every key whose value differs
+// from the one the caller passed in (LoadOptions passes the default).
+class DefaultChecker : public ParamSource {
+ public:
+  explicit DefaultChecker(const ParamSource& inner) : inner_(inner) {}
+  bool Get(const std::string& key, double* v) const override { return Check(key, v); }
+  bool Get(const std::string& key, int* v) const override { return Check(key, v); }
+  bool Get(const std::string& key, bool* v) const override { return Check(key, v); }
+  bool Get(const std::string& key, std::string* v) const override { return Check(key, v); }
+  bool Get(const std::string& key, std::vector<double>* v) const override {
+    const std::vector<double> before = *v;
+    const bool found = inner_.Get(key, v);
+    if (found && *v != before) differs_.push_back(key);
+    if (found) ++found_;
+    return found;
+  }
+  const std::vector<std::string>& differs() const { return differs_; }
+  int found() const { return found_; }
+
+ private:
+  template <typename T>
+  bool Check(const std::string& key, T* v) const {
+    const T before = *v;
+    const bool found = inner_.Get(key, v);
+    if (found) ++found_;
+    if (found && !(*v == before)) {
+      std::ostringstream s;
+      s << key << ": default.yaml " << *v << ", core " << before;
+      differs_.push_back(s.str());
+    }
+    return found;
+  }
+  const ParamSource& inner_;
+  mutable std::vector<std::string> differs_;
+  mutable int found_ = 0;
+};
+
+TEST(ParamsTest, DefaultYamlStatesTheCoreDefaults) {
+  std::unique_ptr<ParamSource> yaml;
+  ASSERT_TRUE(YamlParams({kDefaultYaml}, &yaml).ok());
+  DefaultChecker checker(*yaml);
+  steadiface::PipelineOptions po;
+  WrapperOptions wo;
+  const steadiface::Status s = LoadOptions(checker, &po, &wo);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_GT(checker.found(), 50);  // the file states (nearly) every key
+  std::string all;
+  for (const auto& d : checker.differs()) all += "\n  " + d;
+  EXPECT_TRUE(checker.differs().empty()) << "default.yaml differs from the core:" << all;
+}
+
+TEST(ParamsTest, ReconfigureDefaultsAreTheCoreDefaults) {
+  dynamic_reconfigure::Config from_cfg, from_core;
+  steadiface::SteadifaceConfig::__getDefault__().__toMessage__(from_cfg);
+  ConfigFromOptions(steadiface::StabilizerOptions()).__toMessage__(from_core);
+  ASSERT_EQ(from_cfg.doubles.size(), from_core.doubles.size());
+  ASSERT_GT(from_cfg.doubles.size(), 10u);
+  for (size_t i = 0; i < from_cfg.doubles.size(); ++i) {
+    EXPECT_EQ(from_cfg.doubles[i].name, from_core.doubles[i].name);
+    EXPECT_DOUBLE_EQ(from_cfg.doubles[i].value, from_core.doubles[i].value)
+        << from_cfg.doubles[i].name;
+  }
+  ASSERT_EQ(from_cfg.ints.size(), from_core.ints.size());
+  for (size_t i = 0; i < from_cfg.ints.size(); ++i) {
+    EXPECT_EQ(from_cfg.ints[i].value, from_core.ints[i].value) << from_cfg.ints[i].name;
+  }
+  ASSERT_EQ(from_cfg.bools.size(), from_core.bools.size());
+  for (size_t i = 0; i < from_cfg.bools.size(); ++i) {
+    EXPECT_EQ(from_cfg.bools[i].value, from_core.bools[i].value) << from_cfg.bools[i].name;
+  }
+}
+
+TEST(ParamsTest, AnOutOfRangeValueNamesItsKey) {
+  const std::string path = ::testing::TempDir() + "steadiface_params_test.yaml";
+  {
+    std::ofstream f(path);
+    f << "output:\n  crop_ratio: 0.7\n";
+  }
+  std::unique_ptr<ParamSource> yaml;
+  ASSERT_TRUE(YamlParams({kDefaultYaml, path}, &yaml).ok());
+  steadiface::PipelineOptions po;
+  WrapperOptions wo;
+  const steadiface::Status s = LoadOptions(*yaml, &po, &wo);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("output/crop_ratio"), std::string::npos) << s.message();
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace steadiface_ros
