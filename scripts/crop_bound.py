@@ -9,8 +9,8 @@ window with the scorecard's jitter (linear trend removed, FFT bins under
 0.5 Hz zeroed, RMS, in output pixels) for two policies:
 
   clamp      causal: hold the point still until the margin forces the window
-             to move, then move just enough (what a causal stabilizer can at
-             best do without knowing the future shake);
+             to move, then move just enough (a simple policy that needs no
+             knowledge of the future shake; not proven the best causal one);
   optimum    non-causal: the window path with the least jitter (projected
              gradient on the convex problem), knowing the whole clip.
 

@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
           csv << "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
                  "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty,"
                  "w_fit,protrusion_search_s,previous_warp\n";
-          // The stabilizer's own record (empty for "none"): the w_f in
+          // The stabilizer's own record (nan for "none"): the w_f in
           // effect, how far the protrusion search moved towards the real
           // pose (-1: it did not run) and whether the previous warp was reused.
           const auto& samples = card->samples();
@@ -273,7 +273,8 @@ int main(int argc, char** argv) {
                 << fmt("%.1f%%", 100 * sc.undefined_fraction) << " | " << fmt("%.3f", solver)
                 << " | " << fmt("%.2f", face) << " | " << scoring << " |" << std::endl;
       json << (first ? "" : ",\n") << "    {\"preset\": \"" << preset
-           << "\", \"duration_s\": " << so.duration_s << ", \"method\": \"" << name << "\", \"scoring\": \"" << scoring << "\", \"frames\": " << sc.frames
+           << "\", \"duration_s\": " << so.duration_s << ", \"method\": \"" << name
+           << "\", \"scoring\": \"" << scoring << "\", \"frames\": " << sc.frames
            << ", \"head_jitter_px\": " << jnum(sc.head_jitter_px)
            << ", \"head_jitter_frac\": " << jnum(sc.head_jitter_frac)
            << ", \"background_jitter_px\": " << jnum(sc.background_jitter_px)

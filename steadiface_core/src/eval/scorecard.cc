@@ -237,7 +237,7 @@ Score Scorecard::Compute() const {
   sc.background_jitter_px = nbg ? bg / nbg : NAN;
   // Head relative to each background point, on the longest run of frames
   // where both are in view.
-  double rel = 0.0, floor = 0.0;
+  double rel_sum = 0.0, floor_sum = 0.0;
   int nrel = 0;
   for (const auto& traj : background_out_) {
     // Longest run [begin, end) of frames with both in view.
@@ -256,12 +256,12 @@ Score Scorecard::Compute() const {
       d.push_back(head_out_[i] - traj[i]);
     }
     const double j_rel = HighPassRms(d, fps, options_.highpass_hz);
-    rel += j_rel;
-    floor += std::max(0.0, j_rel - HighPassRms(h, fps, options_.highpass_hz));
+    rel_sum += j_rel;
+    floor_sum += std::max(0.0, j_rel - HighPassRms(h, fps, options_.highpass_hz));
     ++nrel;
   }
-  sc.relative_jitter_px = nrel ? rel / nrel : NAN;
-  sc.background_floor_px = nrel ? floor / nrel : NAN;
+  sc.relative_jitter_px = nrel ? rel_sum / nrel : NAN;
+  sc.background_floor_px = nrel ? floor_sum / nrel : NAN;
   sc.background_jitter_frac = sc.background_jitter_px / diag;
   sc.background_stability = nbg ? bg_stab / nbg : NAN;
   sc.cropping = pose ? std::pow(1.0 - 2.0 * output_.crop_ratio(), 2.0) : 1.0;
