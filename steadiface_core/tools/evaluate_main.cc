@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
       ++failures;
       continue;
     }
-    std::string input_video;  // lossless input for the ffmpeg peers, once per preset
+    std::string input_dir, input_video;  // lossless input for the ffmpeg peers, once per preset
     for (const std::string& name : methods) {
       const bool video = name.size() > 6 && name.compare(name.size() - 6, 6, "/video") == 0;
       const bool peer = name.compare(0, 7, "ffmpeg-") == 0;
@@ -170,7 +170,8 @@ int main(int argc, char** argv) {
             std::cerr << "cannot create a temporary directory\n";
             return 1;
           }
-          const std::string path = std::string(tmpl) + "/input.mkv";
+          input_dir = tmpl;
+          const std::string path = input_dir + "/input.mkv";
           steadiface::eval::LosslessVideoWriter w;
           s = w.Open(path, width, height, so.fps);
           cv::Mat frame;
@@ -194,8 +195,7 @@ int main(int argc, char** argv) {
         std::vector<cv::Mat> frames;
         double seconds = 0.0;
         s = steadiface::eval::RunFfmpegStabilizer(
-            fm, input_video, width, height,
-            input_video.substr(0, input_video.rfind('/')),
+            fm, input_video, width, height, input_dir,
             [&frames](const cv::Mat& f) {
               frames.push_back(f.clone());
               return steadiface::Status::Ok();
@@ -294,10 +294,9 @@ int main(int argc, char** argv) {
       json << "}}";
       first = false;
     }
-    if (!input_video.empty()) {
-      std::remove(input_video.c_str());
-      std::remove((input_video.substr(0, input_video.rfind('/')) + "/vidstab.trf").c_str());
-      rmdir(input_video.substr(0, input_video.rfind('/')).c_str());
+    if (!input_dir.empty()) {
+      std::remove((input_dir + "/input.mkv").c_str());
+      rmdir(input_dir.c_str());
     }
   }
   json << "\n  ]\n}\n";

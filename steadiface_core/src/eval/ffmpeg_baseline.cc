@@ -150,12 +150,14 @@ Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int wi
   const auto t0 = std::chrono::steady_clock::now();
   const std::string base = "ffmpeg -hide_banner -loglevel error -nostdin -y -i " + Quote(input);
   std::string filter;
+  std::string trf;  // vidstab's transforms file, removed when done
   if (method == FfmpegMethod::kVidstab) {
-    const std::string trf = work_dir + "/vidstab.trf";
+    trf = work_dir + "/vidstab.trf";
     const std::string detect =
         base + " -vf format=yuv420p,vidstabdetect=result=" + Quote(trf) + " -f null - 2>&1";
     const std::string log = RunCapture(detect + "; echo \"rc=$?\"");
     if (log.find("rc=0") == std::string::npos) {
+      std::remove(trf.c_str());
       return Status::Error("ffmpeg vidstabdetect failed: " + log);
     }
     filter = "format=yuv420p,vidstabtransform=input=" + Quote(trf);
@@ -164,6 +166,7 @@ Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int wi
   }
   const std::string cmd = base + " -vf " + filter + " -f rawvideo -pix_fmt bgr24 -";
   const Status s = ReadRawFrames(cmd, width, height, FfmpegMethodName(method), sink);
+  if (!trf.empty()) std::remove(trf.c_str());
   if (!s.ok()) return s;
   if (seconds != nullptr) {
     *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <opencv2/core.hpp>
 
@@ -13,6 +14,19 @@
 namespace steadiface {
 namespace eval {
 namespace {
+
+// The longest run [first, second) of consecutive indices in [0, n) where
+// `ok(i)` holds; the first such run on ties, empty if there is none.
+template <typename Pred>
+std::pair<size_t, size_t> LongestRun(size_t n, Pred ok) {
+  std::pair<size_t, size_t> best(0, 0);
+  for (size_t i = 0, start = 0; i <= n; ++i) {
+    if (i < n && ok(i)) continue;
+    if (i - start > best.second - best.first) best = {start, i};
+    start = i + 1;
+  }
+  return best;
+}
 
 // Power spectrum of a real series (DFT), bins 0..n/2.
 std::vector<double> Power(const std::vector<double>& x) {
@@ -197,16 +211,8 @@ void Scorecard::Add(int index, const FrameWarp& w) {
 }
 
 std::vector<Eigen::Vector2d> Scorecard::LongestFiniteRun(const std::vector<Eigen::Vector2d>& x) {
-  std::vector<Eigen::Vector2d> run, best;
-  for (size_t i = 0; i <= x.size(); ++i) {
-    if (i < x.size() && x[i].allFinite()) {
-      run.push_back(x[i]);
-    } else {
-      if (run.size() > best.size()) best = run;
-      run.clear();
-    }
-  }
-  return best;
+  const auto run = LongestRun(x.size(), [&x](size_t i) { return x[i].allFinite(); });
+  return std::vector<Eigen::Vector2d>(x.begin() + run.first, x.begin() + run.second);
 }
 
 Score Scorecard::Compute() const {
@@ -240,18 +246,12 @@ Score Scorecard::Compute() const {
   double rel_sum = 0.0, floor_sum = 0.0;
   int nrel = 0;
   for (const auto& traj : background_out_) {
-    // Longest run [begin, end) of frames with both in view.
-    size_t begin = 0, end = 0;
-    for (size_t i = 0, start = 0; i <= traj.size(); ++i) {
-      const bool both = i < traj.size() && i < head_out_.size() && traj[i].allFinite() &&
-                        head_out_[i].allFinite();
-      if (both) continue;
-      if (i - start > end - begin) begin = start, end = i;
-      start = i + 1;
-    }
-    if (end - begin < min_run) continue;
+    const auto run = LongestRun(std::min(traj.size(), head_out_.size()), [&](size_t i) {
+      return traj[i].allFinite() && head_out_[i].allFinite();
+    });
+    if (run.second - run.first < min_run) continue;
     std::vector<Eigen::Vector2d> h, d;
-    for (size_t i = begin; i < end; ++i) {
+    for (size_t i = run.first; i < run.second; ++i) {
       h.push_back(head_out_[i]);
       d.push_back(head_out_[i] - traj[i]);
     }

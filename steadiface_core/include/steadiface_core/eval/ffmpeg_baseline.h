@@ -48,7 +48,9 @@ Status ReadVideo(const std::string& path, const std::function<Status(const cv::M
 /// Runs `method` with its default settings on `input` (any video ffmpeg
 /// reads; converted to yuv420p first, the format phone videos come in and
 /// the one libvidstab handles — it aborts on packed or planar RGB),
-/// decoding the stabilized frames to bgr8 and handing each to `sink`. `work_dir` holds vidstab's transforms file. `seconds` receives
+/// decoding the stabilized frames to bgr8 and handing each to `sink`.
+/// `work_dir` holds vidstab's transforms file while it runs (removed
+/// afterwards). `seconds` receives
 /// the wall time of the ffmpeg passes (including decoding the input and
 /// handing frames over).
 Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int width,
