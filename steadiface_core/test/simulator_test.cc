@@ -152,11 +152,9 @@ TEST(ScorecardTest, IdentityOnAStillSceneScoresZeroJitter) {
     o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
     o->head.yaw_amplitude_rad = o->head.pitch_amplitude_rad = o->head.lean_amplitude_m = 0.0;
   });
-  CameraModel m;
-  ASSERT_TRUE(CameraModel::Create(s->intrinsics(), CameraModelOptions(), &m).ok());
-  OutputGeometry og;
-  ASSERT_TRUE(OutputGeometry::Create(m, OutputOptions(), &og).ok());
-  eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+  std::unique_ptr<eval::Scorecard> scorecard;
+  ASSERT_TRUE(eval::MakeScorecard(*s, PipelineOptions(), &scorecard).ok());
+  eval::Scorecard& card = *scorecard;
   for (int i = 0; i < s->num_frames(); ++i) card.Add(i, eval::FrameWarp());
   const eval::Score sc = card.Compute();
   EXPECT_NEAR(sc.head_jitter_px, 0.0, 1e-9);
@@ -168,11 +166,9 @@ TEST(ScorecardTest, IdentityOnAStillSceneScoresZeroJitter) {
 
 TEST(ScorecardTest, AWarpThatCancelsTheTrueMotionScoresNearZero) {
   auto s = Make("walk");
-  CameraModel m;
-  ASSERT_TRUE(CameraModel::Create(s->intrinsics(), CameraModelOptions(), &m).ok());
-  OutputGeometry og;
-  ASSERT_TRUE(OutputGeometry::Create(m, OutputOptions(), &og).ok());
-  eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+  std::unique_ptr<eval::Scorecard> scorecard;
+  ASSERT_TRUE(eval::MakeScorecard(*s, PipelineOptions(), &scorecard).ok());
+  eval::Scorecard& card = *scorecard;
   const Eigen::Quaterniond R0 = s->Truth(0).R_r[7];
   for (int i = 0; i < s->num_frames(); ++i) {
     const sim::SimTruth t = s->Truth(i);
@@ -195,11 +191,9 @@ TEST(ScorecardTest, AddedJitterRaisesTheScoreByTheExpectedAmount) {
     o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
     o->head.yaw_amplitude_rad = o->head.pitch_amplitude_rad = o->head.lean_amplitude_m = 0.0;
   });
-  CameraModel m;
-  ASSERT_TRUE(CameraModel::Create(s->intrinsics(), CameraModelOptions(), &m).ok());
-  OutputGeometry og;
-  ASSERT_TRUE(OutputGeometry::Create(m, OutputOptions(), &og).ok());
-  eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+  std::unique_ptr<eval::Scorecard> scorecard;
+  ASSERT_TRUE(eval::MakeScorecard(*s, PipelineOptions(), &scorecard).ok());
+  eval::Scorecard& card = *scorecard;
   const double a = 4.0;  // px amplitude at 5 Hz (an exact bin for 90 frames at 30 fps)
   for (int i = 0; i < s->num_frames(); ++i) {
     eval::FrameWarp w;
@@ -223,13 +217,10 @@ TEST(ScorecardTest, AddedJitterRaisesTheScoreByTheExpectedAmount) {
 // the background column mostly measures how a method follows the pan.
 TEST(ScorecardTest, ThePanItselfScoresMostOfThePanPresetsBackgroundJitter) {
   auto input_background = [](const sim::Simulator& s) {
-    CameraModel m;
-    EXPECT_TRUE(CameraModel::Create(s.intrinsics(), CameraModelOptions(), &m).ok());
-    OutputGeometry og;
-    EXPECT_TRUE(OutputGeometry::Create(m, OutputOptions(), &og).ok());
-    eval::Scorecard card(s, m, og, eval::ScorecardOptions());
-    for (int i = 0; i < s.num_frames(); ++i) card.Add(i, eval::FrameWarp());
-    return card.Compute().background_jitter_px;
+    std::unique_ptr<eval::Scorecard> card;
+    EXPECT_TRUE(eval::MakeScorecard(s, PipelineOptions(), &card).ok());
+    for (int i = 0; i < s.num_frames(); ++i) card->Add(i, eval::FrameWarp());
+    return card->Compute().background_jitter_px;
   };
   const double pan_only = input_background(*Make("pan", [](sim::SimulatorOptions* o) {
     o->camera.shake_rms_rad = 0.0;
@@ -251,20 +242,17 @@ TEST(ScorecardTest, ThePanItselfScoresMostOfThePanPresetsBackgroundJitter) {
 // the head is held.
 TEST(ScorecardTest, RelativeJitterIsFixedByTheSceneAndBoundsTheBackground) {
   auto s = Make("still");
-  CameraModel m;
-  ASSERT_TRUE(CameraModel::Create(s->intrinsics(), CameraModelOptions(), &m).ok());
-  OutputGeometry og;
-  ASSERT_TRUE(OutputGeometry::Create(m, OutputOptions(), &og).ok());
   const Eigen::Vector2d head0 = s->Truth(0).head_px;
   auto score = [&](auto shift_of_frame) {
-    eval::Scorecard card(*s, m, og, eval::ScorecardOptions());
+    std::unique_ptr<eval::Scorecard> card;
+    EXPECT_TRUE(eval::MakeScorecard(*s, PipelineOptions(), &card).ok());
     for (int i = 0; i < s->num_frames(); ++i) {
       eval::FrameWarp w;
       w.kind = eval::FrameWarp::Kind::kHomography;
       w.H.topRightCorner<2, 1>() = shift_of_frame(i);
-      card.Add(i, w);
+      card->Add(i, w);
     }
-    return card.Compute();
+    return card->Compute();
   };
   const eval::Score input = score([](int) { return Eigen::Vector2d::Zero(); });
   const eval::Score held = score([&](int i) -> Eigen::Vector2d {
