@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "steadiface_core/face/head_pose.h"
-#include "steadiface_core/sim/face_model.h"
+#include "steadiface_core/face/generic_face.h"
 #include "steadiface_core/sim/scene_renderer.h"
 #include "steadiface_core/so3.h"
 #include "test_util.h"
@@ -440,7 +440,7 @@ TEST(FaceTrackerTest, ExternalLandmarksUseTheSameChecks) {
 
 TEST(HeadPoseTest, RecoversKnownRotationsOfTheGenericFace) {
   const CameraIntrinsics k = IntrinsicsFromHorizontalFov(640, 480, 1.0);
-  const auto& model = sim::GenericFace68();
+  const auto& model = GenericFace68();
   for (const Eigen::Vector3d& ypr :
        {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.4, 0.0, 0.0),
         Eigen::Vector3d(-0.3, 0.2, 0.0), Eigen::Vector3d(0.1, -0.25, 0.15)}) {

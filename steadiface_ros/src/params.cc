@@ -140,6 +140,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   Reader r(params);
   // ROS layer.
   r.Str("camera_frame", &wo->camera_frame);
+  r.Str("camera_info_url", &wo->camera_info_url);
   r.Str("stabilized_suffix", &wo->stabilized_suffix);
   r.Str("world_frame", &wo->world_frame);
   r.Bool("publish_world_tf", &wo->publish_world_tf);

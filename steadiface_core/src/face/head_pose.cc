@@ -5,13 +5,13 @@
 #include <Eigen/Geometry>
 #include <opencv2/calib3d.hpp>
 
-#include "steadiface_core/sim/face_model.h"
+#include "steadiface_core/face/generic_face.h"
 
 namespace steadiface {
 
 std::vector<Eigen::Vector3d> BuildHeadModel(
     const std::vector<Eigen::Vector2d>& mean_shape) {
-  const auto& generic = sim::GenericFace68();
+  const auto& generic = GenericFace68();
   if (mean_shape.size() != generic.size()) return generic;
   Eigen::Vector2d eyes = Eigen::Vector2d::Zero();
   for (int i = 36; i < 48; ++i) eyes += mean_shape[i];

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "steadiface_core/sim/face_model.h"
+#include "steadiface_core/face/generic_face.h"
 
 namespace steadiface {
 namespace sim {

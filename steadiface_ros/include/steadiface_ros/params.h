@@ -43,6 +43,11 @@ enum class LateFramePolicy {
 struct WrapperOptions {
   /// Frame of the published stabilized image; empty = input frame + suffix.
   std::string camera_frame;
+  /// Intrinsics for images that come without a camera_info message: a
+  /// camera_calibration YAML or INI file, as file:///abs/path,
+  /// package://pkg/path or a plain path. Empty = camera_info messages only.
+  /// A camera_info message, when there is one, wins.
+  std::string camera_info_url;
   std::string stabilized_suffix = "_stabilized";
   std::string world_frame = "steadiface_world";
   bool publish_world_tf = true;

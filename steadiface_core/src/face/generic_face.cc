@@ -1,9 +1,8 @@
-#include "steadiface_core/sim/face_model.h"
+#include "steadiface_core/face/generic_face.h"
 
 #include <cmath>
 
 namespace steadiface {
-namespace sim {
 namespace {
 
 std::vector<Eigen::Vector3d> Build() {
@@ -75,5 +74,4 @@ const std::vector<Eigen::Vector3d>& GenericFace68() {
   return model;
 }
 
-}  // namespace sim
 }  // namespace steadiface

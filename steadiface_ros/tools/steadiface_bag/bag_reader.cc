@@ -1,0 +1,109 @@
+#include "steadiface_bag/bag_reader.h"
+
+#include <iostream>
+#include <map>
+
+#include <rosbag/view.h>
+
+namespace steadiface_bag {
+
+std::string NormalizeTopic(const std::string& t) {
+  return t.empty() || t[0] == '/' ? t : "/" + t;
+}
+
+BagReader::~BagReader() { Join(); }
+
+steadiface::Status BagReader::Open(bool info_required) {
+  using steadiface::Status;
+  try {
+    bag_.open(path_, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& e) {
+    return Status::Error("cannot open '" + path_ + "': " + e.what());
+  }
+  std::map<std::string, std::string> types;
+  {
+    rosbag::View all(bag_);
+    for (const rosbag::ConnectionInfo* c : all.getConnections()) {
+      types[NormalizeTopic(c->topic)] = c->datatype;
+    }
+  }
+  const std::vector<std::pair<std::string, std::string>> want = {
+      {topics_.image, "sensor_msgs/Image"},
+      {topics_.info, "sensor_msgs/CameraInfo"},
+      {topics_.imu, "sensor_msgs/Imu"}};
+  for (const auto& w : want) {
+    auto it = types.find(NormalizeTopic(w.first));
+    if (it == types.end()) {
+      const bool is_info = w.second == "sensor_msgs/CameraInfo";
+      if (is_info && !info_required) continue;  // intrinsics from camera_info_url
+      std::cerr << "steadiface_bag: topic '" << NormalizeTopic(w.first) << "' (" << w.second
+                << ") is not in " << path_ << "; topics there:";
+      for (const auto& t : types) std::cerr << " " << t.first << " [" << t.second << "]";
+      std::cerr << "\n";
+      if (is_info) {
+        return Status::Error(
+            "no camera_info: name its topic with --info, or give the intrinsics with a "
+            "camera_info_url in a --params file");
+      }
+      if (w.second != "sensor_msgs/Imu") return Status::Error("no image topic");
+      std::cerr << "steadiface_bag: continuing without IMU: frames pass through unstabilized\n";
+    } else if (it->second != w.second) {
+      return Status::Error("topic '" + NormalizeTopic(w.first) + "' has type " + it->second +
+                           ", expected " + w.second);
+    } else if (w.second == "sensor_msgs/CameraInfo") {
+      has_info_ = true;
+    }
+  }
+  return Status::Ok();
+}
+
+std::vector<std::string> BagReader::WithAndWithoutSlash(const std::string& t) const {
+  std::vector<std::string> v = {NormalizeTopic(t)};
+  if (NormalizeTopic(t).size() > 1) v.push_back(NormalizeTopic(t).substr(1));
+  return v;
+}
+
+size_t BagReader::ImageCount() const {
+  return rosbag::View(bag_, rosbag::TopicQuery(WithAndWithoutSlash(topics_.image))).size();
+}
+
+void BagReader::Start(BoundedQueue<BagItem>* queue) {
+  thread_ = std::thread([this, queue] {
+    std::vector<std::string> topics;
+    for (const std::string& t : {topics_.image, topics_.info, topics_.imu, topics_.landmarks}) {
+      if (t.empty()) continue;
+      for (const auto& v : WithAndWithoutSlash(t)) topics.push_back(v);
+    }
+    const std::string imu = NormalizeTopic(topics_.imu), info = NormalizeTopic(topics_.info),
+                      landmarks = NormalizeTopic(topics_.landmarks),
+                      image = NormalizeTopic(topics_.image);
+    try {
+      rosbag::View view(bag_, rosbag::TopicQuery(topics));
+      for (const rosbag::MessageInstance& m : view) {
+        BagItem item;
+        const std::string topic = NormalizeTopic(m.getTopic());
+        item.time = m.getTime();
+        if (topic == imu) {
+          item.imu = m.instantiate<sensor_msgs::Imu>();
+        } else if (topic == info) {
+          item.info = m.instantiate<sensor_msgs::CameraInfo>();
+        } else if (topic == landmarks) {
+          item.landmarks = m.instantiate<steadiface::FaceLandmarks>();
+        } else if (topic == image) {
+          item.image = m.instantiate<sensor_msgs::Image>();
+        }
+        if (!queue->Push(std::move(item))) break;
+      }
+    } catch (const std::exception& e) {
+      error_ = e.what();
+    }
+    queue->Close();
+  });
+}
+
+std::string BagReader::Join() {
+  if (thread_.joinable()) thread_.join();
+  return error_;
+}
+
+}  // namespace steadiface_bag

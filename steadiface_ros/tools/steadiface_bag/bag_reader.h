@@ -1,0 +1,75 @@
+#pragma once
+
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <rosbag/bag.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
+
+#include "steadiface/FaceLandmarks.h"
+#include "steadiface_core/status.h"
+#include "steadiface_bag/bounded_queue.h"
+
+namespace steadiface_bag {
+
+/// "/a/b" for "a/b" and "/a/b" (bags store topics with or without the
+/// leading '/').
+std::string NormalizeTopic(const std::string& topic);
+
+/// The topics the tool reads. `landmarks` may be empty.
+struct BagTopics {
+  std::string image = "camera/image_raw";
+  std::string info = "camera/camera_info";
+  std::string imu = "imu";
+  std::string landmarks;
+};
+
+/// One decoded bag message: exactly one pointer is set for the topics the
+/// tool reads (none for a message whose type did not instantiate).
+struct BagItem {
+  ros::Time time;
+  sensor_msgs::ImuConstPtr imu;
+  sensor_msgs::CameraInfoConstPtr info;
+  sensor_msgs::ImageConstPtr image;
+  steadiface::FaceLandmarksConstPtr landmarks;
+};
+
+/// The reader stage: opens the input bag, checks its topics and types, and
+/// decodes the wanted messages in bag order on its own thread into a bounded
+/// queue (LZ4/BZ2 decompression and deserialization overlap the
+/// stabilizer).
+class BagReader {
+ public:
+  BagReader(const std::string& path, const BagTopics& topics) : path_(path), topics_(topics) {}
+  ~BagReader();
+
+  /// Opens the bag and checks the topics. A missing image topic, a wrong
+  /// type, or a missing camera_info topic when `info_required` is an error;
+  /// a missing IMU topic only a warning (frames pass through unstabilized).
+  /// Messages go to stderr.
+  steadiface::Status Open(bool info_required);
+  /// Whether the bag has the camera_info topic.
+  bool has_info() const { return has_info_; }
+  /// Number of messages on the image topic.
+  size_t ImageCount() const;
+  /// Starts the reader thread; it closes `queue` at the end or on error.
+  void Start(BoundedQueue<BagItem>* queue);
+  /// Waits for the reader thread; returns its error ("" if none).
+  std::string Join();
+  void Close() { bag_.close(); }
+
+ private:
+  std::vector<std::string> WithAndWithoutSlash(const std::string& t) const;
+
+  const std::string path_;
+  const BagTopics topics_;
+  rosbag::Bag bag_;
+  bool has_info_ = false;
+  std::thread thread_;
+  std::string error_;  // written by the reader thread, read after join
+};
+
+}  // namespace steadiface_bag

@@ -1,0 +1,145 @@
+#include "steadiface_bag/bag_writer.h"
+
+#include <cstdio>
+#include <iostream>
+
+#include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgproc.hpp>
+#include <tf2_msgs/TFMessage.h>
+
+#include "steadiface_ros/msg_conversion.h"
+
+namespace steadiface_bag {
+
+AsyncBagWriter::AsyncBagWriter(rosbag::Bag* bag) : bag_(bag), queue_(64) {
+  thread_ = std::thread([this] {
+    std::function<void()> job;
+    while (queue_.Pop(&job)) {
+      if (!error_.empty()) continue;  // drain after a failure
+      try {
+        job();
+      } catch (const std::exception& e) {
+        error_ = e.what();
+      }
+    }
+  });
+}
+
+std::string AsyncBagWriter::Finish() {
+  if (thread_.joinable()) {
+    queue_.Close();
+    thread_.join();
+  }
+  return error_;
+}
+
+void BagSink::PublishImage(const sensor_msgs::ImagePtr& image,
+                           const sensor_msgs::CameraInfoPtr& info) {
+  last_image = image;
+  last_info = *info;
+  if (out) {
+    out->Write(T("image_stabilized/image_raw"), image->header.stamp,
+               sensor_msgs::ImageConstPtr(image));
+    out->Write(T("image_stabilized/camera_info"), info->header.stamp,
+               sensor_msgs::CameraInfoConstPtr(info));
+  }
+}
+
+void BagSink::PublishLandmarks(const steadiface::FaceLandmarks& m) {
+  landmarks.push_back(m);
+  if (out) out->WriteCopy(T("face_landmarks"), m.header.stamp, m);
+}
+
+void BagSink::PublishState(const steadiface::StabilizerState& m) {
+  states.push_back(m);
+  infos_out.push_back(last_info);  // PublishImage precedes PublishState
+  if (out) out->WriteCopy(T("state"), m.header.stamp, m);
+}
+
+void BagSink::PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) {
+  tfs.insert(tfs.end(), tf.begin(), tf.end());
+  if (out && !tf.empty()) {
+    tf2_msgs::TFMessage m;
+    m.transforms = tf;
+    out->WriteCopy("/tf", tf.front().header.stamp, m);
+  }
+}
+
+void BagSink::PublishDebugImage(const sensor_msgs::ImagePtr& image) {
+  last_debug = image;
+  if (out && debug_to_bag) {
+    out->Write(T("debug_image"), image->header.stamp, sensor_msgs::ImageConstPtr(image));
+  }
+}
+
+void BagSink::Warn(const std::string& key, const std::string& text) {
+  if (warnings[key]++ == 0) std::cerr << "warning: " << text << "\n";
+}
+
+void BagSink::Error(const std::string& key, const std::string& text) {
+  if (warnings[key]++ == 0) std::cerr << "error: " << text << "\n";
+}
+
+SideBySideVideo::SideBySideVideo(const std::string& path)
+    : path_(path), tmp_(path.empty() ? "" : path + ".part.mp4") {}
+
+SideBySideVideo::~SideBySideVideo() {
+  if (thread_.joinable()) {
+    queue_->Close();
+    thread_.join();
+  }
+}
+
+void SideBySideVideo::AddInput(const sensor_msgs::Image& image) {
+  if (!enabled()) return;
+  cv::Mat mat;
+  if (steadiface_ros::ToCvImage(image, &mat).ok()) inputs_[image.header.stamp] = mat.clone();
+  while (inputs_.size() > 32) inputs_.erase(inputs_.begin());
+}
+
+void SideBySideVideo::AddOutput(BagSink* sink) {
+  // Pair every new stabilized output with its input frame.
+  if (!enabled() || !sink->last_image) return;
+  const ros::Time t = sink->last_image->header.stamp;
+  auto it = inputs_.find(t);
+  if (it == inputs_.end()) return;
+  cv::Mat left = it->second, right;
+  if (sink->debug && sink->last_debug && sink->last_debug->header.stamp == t) {
+    left = cv_bridge::toCvCopy(sink->last_debug, "bgr8")->image;
+  }
+  right = cv_bridge::toCvCopy(sink->last_image, "bgr8")->image;
+  if (left.channels() == 1) cv::cvtColor(left, left, cv::COLOR_GRAY2BGR);
+  cv::resize(right, right, left.size());
+  cv::Mat both;
+  cv::hconcat(left, right, both);
+  if (!queue_) {  // first frame: open (the encoder thread owns video_ after)
+    const double fps = 30.0;
+    video_.open(tmp_, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps, both.size());
+    if (!video_.isOpened()) {
+      std::cerr << "steadiface_bag: cannot write video '" << tmp_ << "'\n";
+      path_.clear();
+      return;
+    }
+    queue_.reset(new BoundedQueue<cv::Mat>(8));
+    thread_ = std::thread([this] {
+      cv::Mat frame;
+      while (queue_->Pop(&frame)) video_.write(frame);
+    });
+  }
+  queue_->Push(both);
+  inputs_.erase(inputs_.begin(), std::next(it));
+  sink->last_image.reset();
+}
+
+void SideBySideVideo::Finish() {
+  if (thread_.joinable()) {
+    queue_->Close();
+    thread_.join();
+  }
+  if (video_.isOpened()) {
+    video_.release();
+    std::rename(tmp_.c_str(), path_.c_str());
+  }
+}
+
+}  // namespace steadiface_bag
