@@ -1,6 +1,6 @@
 // Warp stage benchmarks (issue: mesh warping). Arguments: width, height,
 // channels (1 = mono8, 3 = bgr8), threads.
-//   build/devel/lib/steadiface/steadiface_warp_benchmark
+//   devel/lib/steadiface/steadiface_warp_benchmark
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core.hpp>

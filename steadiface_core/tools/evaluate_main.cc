@@ -62,6 +62,10 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+    if (a == "--help" || a == "-h") {
+      Usage();
+      return 0;
+    }
     if (a == "--data") data = next();
     else if (a == "--out") out_dir = next();
     else if (a == "--presets") presets = Split(next());

@@ -29,6 +29,10 @@ int main(int argc, char** argv) {
   double fps = 30.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::cerr << "usage: steadiface_score_video VIDEO [--fps F] [--name LABEL]\n";
+      return 0;
+    }
     if (a == "--fps" && i + 1 < argc) fps = std::atof(argv[++i]);
     else if (a == "--name" && i + 1 < argc) name = argv[++i];
     else if (!a.empty() && a[0] != '-' && path.empty()) path = a;

@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+    if (a == "--help" || a == "-h") {
+      Usage();
+      return 0;
+    }
     if (a == "--preset") preset = next();
     else if (a == "--out") out = next();
     else if (a == "--duration") o.duration_s = std::atof(next().c_str());
