@@ -1,6 +1,8 @@
 #include "steadiface_ros/stabilizer_ros.h"
 
 
+#include <cmath>
+
 #include "steadiface_ros/msg_conversion.h"
 
 namespace steadiface_ros {
@@ -13,6 +15,19 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   if (!s.ok()) {
     ROS_ERROR("[%s] invalid parameters, the stabilizer will not run: %s", name_.c_str(),
               s.message().c_str());
+    return;
+  }
+  info_source_.reset(new CameraInfoSource([this](bool is_error, const std::string& text) {
+    if (is_error) {
+      ROS_ERROR_STREAM_THROTTLE(5.0, "[" << name_ << "] " << text);
+    } else {
+      ROS_INFO_STREAM("[" << name_ << "] " << text);
+    }
+  }));
+  const steadiface::Status info_status = info_source_->Load(wrapper_options_.camera_info_url);
+  if (!info_status.ok()) {
+    ROS_ERROR("[%s] invalid camera_info_url, the stabilizer will not run: %s", name_.c_str(),
+              info_status.message().c_str());
     return;
   }
   tf_buffer_.reset(new tf2_ros::Buffer);
@@ -71,7 +86,12 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   // 4. Subscribers: IMU never lazy, with a large queue.
   imu_sub_ = nh_.subscribe("imu", 2000, &StabilizerRos::OnImu, this,
                            ros::TransportHints().tcpNoDelay());
-  image_sub_ = it_->subscribeCamera("image_raw", 5, &StabilizerRos::OnImage, this);
+  if (info_source_->has_file_info()) {
+    image_only_sub_ = it_->subscribe("image_raw", 5, &StabilizerRos::OnImageOnly, this);
+    info_sub_ = nh_.subscribe("camera_info", 5, &StabilizerRos::OnCameraInfo, this);
+  } else {
+    image_sub_ = it_->subscribeCamera("image_raw", 5, &StabilizerRos::OnImage, this);
+  }
   if (pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal) {
     landmarks_sub_ = nh_.subscribe("landmarks_in", 10, &StabilizerRos::OnLandmarks, this);
   }
@@ -91,6 +111,8 @@ StabilizerRos::~StabilizerRos() {
   // Stop the inputs first so nothing calls into a half-destroyed object.
   timer_.stop();
   image_sub_.shutdown();
+  image_only_sub_.shutdown();
+  info_sub_.shutdown();
   imu_sub_.shutdown();
   landmarks_sub_.shutdown();
   reconfigure_.reset();
@@ -100,6 +122,22 @@ void StabilizerRos::OnImage(const sensor_msgs::ImageConstPtr& image,
                             const sensor_msgs::CameraInfoConstPtr& info) {
   image_freq_->tick();
   wrapper_->OnImage(image, info, ros::Time::now());
+}
+
+void StabilizerRos::OnImageOnly(const sensor_msgs::ImageConstPtr& image) {
+  image_freq_->tick();
+  sensor_msgs::CameraInfoConstPtr from_message;
+  if (latest_info_ &&
+      std::abs((latest_info_->header.stamp - image->header.stamp).toSec()) <= 0.5) {
+    from_message = latest_info_;
+  }
+  // Null (size mismatch, reported by the source): the wrapper counts the
+  // frame as dropped for its camera_info.
+  wrapper_->OnImage(image, info_source_->Select(*image, from_message), ros::Time::now());
+}
+
+void StabilizerRos::OnCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
+  latest_info_ = info;
 }
 
 void StabilizerRos::OnImu(const sensor_msgs::ImuConstPtr& msg) {

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <string>
 
+#include <camera_calibration_parsers/parse.h>
 #include <cv_bridge/cv_bridge.h>
 #include <opencv2/imgproc.hpp>
 #include <ros/package.h>
@@ -27,7 +28,13 @@ namespace {
 int Usage() {
   std::cerr << "usage: steadiface_simulate --preset NAME --out FILE.bag [--duration S]\n"
                "  [--size WxH] [--fps F] [--imu-rate HZ] [--seed N] [--mono] [--data DIR]\n"
-               "  [--clock-offset S] [--readout S] [--epoch S] [--no-face]\n"
+               "  [--clock-offset S] [--readout S] [--epoch S] [--no-face] [--hfov RAD]\n"
+               "  [--image-topic T] [--info-topic T|none] [--imu-topic T]\n"
+               "  [--camera-frame F] [--imu-frame F]\n"
+               "  [--imu-rotation qx,qy,qz,qw: the IMU's mounting, R_imu_cam; the gyro is\n"
+               "   recorded in IMU axes, so the stabilizer needs imu/R_cam_imu = its inverse]\n"
+               "  [--calibration-out FILE.yaml: the camera's intrinsics as a camera_calibration\n"
+               "   YAML, for camera_info_url]\n"
                "presets: still walk pan run occlusion two_faces turn_away\n";
   return 2;
 }
@@ -40,6 +47,10 @@ int main(int argc, char** argv) {
   bool mono = false;
   double epoch = 1.7e9;  // bag stamps start here (a realistic ROS time)
   double readout = -1;
+  std::string image_topic = "/camera/image_raw", info_topic = "/camera/camera_info",
+              imu_topic = "/imu", camera_frame = "camera_optical", imu_frame = "camera_optical",
+              calibration_out;
+  Eigen::Quaterniond R_imu_cam = Eigen::Quaterniond::Identity();
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -59,6 +70,20 @@ int main(int argc, char** argv) {
     else if (a == "--clock-offset") o.imu_clock_offset_s = std::atof(next().c_str());
     else if (a == "--readout") readout = std::atof(next().c_str());
     else if (a == "--epoch") epoch = std::atof(next().c_str());
+    else if (a == "--hfov") o.hfov_rad = std::atof(next().c_str());
+    else if (a == "--image-topic") image_topic = next();
+    else if (a == "--info-topic") info_topic = next();
+    else if (a == "--imu-topic") imu_topic = next();
+    else if (a == "--camera-frame") camera_frame = next();
+    else if (a == "--imu-frame") imu_frame = next();
+    else if (a == "--calibration-out") calibration_out = next();
+    else if (a == "--imu-rotation") {
+      double x, y, z, w;
+      if (std::sscanf(next().c_str(), "%lf,%lf,%lf,%lf", &x, &y, &z, &w) != 4) return Usage();
+      R_imu_cam = Eigen::Quaterniond(w, x, y, z);
+      if (!(R_imu_cam.norm() > 0.5)) return Usage();
+      R_imu_cam.normalize();
+    }
     else if (a == "--size") {
       if (std::sscanf(next().c_str(), "%dx%d", &o.width, &o.height) != 2) return Usage();
     } else {
@@ -98,12 +123,13 @@ int main(int argc, char** argv) {
     for (; g < imu.size() && (!until || to_ros(imu[g].stamp) <= *until); ++g) {
       sensor_msgs::Imu m;
       m.header.stamp = to_ros(imu[g].stamp);
-      m.header.frame_id = "camera_optical";
-      m.angular_velocity.x = imu[g].angular_velocity.x();
-      m.angular_velocity.y = imu[g].angular_velocity.y();
-      m.angular_velocity.z = imu[g].angular_velocity.z();
+      m.header.frame_id = imu_frame;
+      const Eigen::Vector3d w = R_imu_cam * imu[g].angular_velocity;
+      m.angular_velocity.x = w.x();
+      m.angular_velocity.y = w.y();
+      m.angular_velocity.z = w.z();
       m.orientation_covariance[0] = -1;
-      bag.write("/imu", m.header.stamp, m);
+      bag.write(imu_topic, m.header.stamp, m);
     }
   };
   std::ofstream csv(out + ".truth.csv");
@@ -128,10 +154,10 @@ int main(int argc, char** argv) {
     }
     std_msgs::Header h;
     h.stamp = stamp;
-    h.frame_id = "camera_optical";
+    h.frame_id = camera_frame;
     h.seq = i;
-    bag.write("/camera/image_raw", last_row, cv_bridge::CvImage(h, enc, img).toImageMsg());
-    bag.write("/camera/camera_info", last_row, steadiface_ros::ToCameraInfo(k, h));
+    bag.write(image_topic, last_row, cv_bridge::CvImage(h, enc, img).toImageMsg());
+    if (info_topic != "none") bag.write(info_topic, last_row, steadiface_ros::ToCameraInfo(k, h));
     csv << i << "," << stamp.toSec() << "," << truth.head_px.x() << "," << truth.head_px.y() << ","
         << truth.head_in_view << "," << truth.face_scale_px << "," << truth.occluded << ","
         << truth.face_out << "," << truth.second_face;
@@ -140,6 +166,13 @@ int main(int argc, char** argv) {
   }
   write_imu(nullptr);
   bag.close();
+  if (!calibration_out.empty()) {
+    sensor_msgs::CameraInfo ci = steadiface_ros::ToCameraInfo(k, std_msgs::Header());
+    if (!camera_calibration_parsers::writeCalibration(calibration_out, camera_frame, ci)) {
+      std::cerr << "steadiface_simulate: cannot write " << calibration_out << "\n";
+      return 1;
+    }
+  }
   if (std::rename(tmp.c_str(), out.c_str()) != 0) {
     std::cerr << "steadiface_simulate: cannot rename " << tmp << "\n";
     return 1;

@@ -17,6 +17,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "steadiface/SteadifaceConfig.h"
+#include "steadiface_ros/camera_info_source.h"
 #include "steadiface_ros/stabilizer_wrapper.h"
 
 namespace steadiface_ros {
@@ -60,6 +61,10 @@ class StabilizerRos : public OutputSink {
  private:
   void OnImage(const sensor_msgs::ImageConstPtr& image,
                const sensor_msgs::CameraInfoConstPtr& info);
+  // With camera_info_url: images and camera_info subscribed separately; a
+  // camera_info message within 0.5 s of the image wins over the file.
+  void OnImageOnly(const sensor_msgs::ImageConstPtr& image);
+  void OnCameraInfo(const sensor_msgs::CameraInfoConstPtr& info);
   void OnImu(const sensor_msgs::ImuConstPtr& msg);
   void OnLandmarks(const steadiface::FaceLandmarksConstPtr& msg);
   void OnTimer(const ros::TimerEvent& e);
@@ -92,6 +97,10 @@ class StabilizerRos : public OutputSink {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
 
   image_transport::CameraSubscriber image_sub_;
+  std::unique_ptr<CameraInfoSource> info_source_;
+  image_transport::Subscriber image_only_sub_;  // camera_info_url mode
+  ros::Subscriber info_sub_;                    // camera_info_url mode
+  sensor_msgs::CameraInfoConstPtr latest_info_;
   ros::Subscriber imu_sub_, landmarks_sub_;
   ros::Timer timer_;
 
