@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sensor_msgs/image_encodings.h>
 
@@ -93,6 +94,37 @@ geometry_msgs::Transform ToTransformMsg(const Eigen::Quaterniond& q) {
   return t;
 }
 
+namespace {
+
+// Pixel layout of an encoding: what image_encodings knows, plus the YUYV
+// names that Debian 12's image_encodings lacks. False for an unknown name.
+bool PixelLayout(const std::string& e, int* channels, int* depth) {
+  if (e == "yuyv" || e == "yuv422_yuy2" || e == "uyvy") {
+    *channels = 2;
+    *depth = 8;
+    return true;
+  }
+  try {
+    *channels = sensor_msgs::image_encodings::numChannels(e);
+    *depth = sensor_msgs::image_encodings::bitDepth(e);
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// ROS bayer pattern (its top-left 2x2) -> OpenCV's demosaicing code (OpenCV
+// names the pattern by the second row's second and third pixels).
+int BayerToBgrCode(const std::string& e) {
+  namespace enc = sensor_msgs::image_encodings;
+  if (e == enc::BAYER_RGGB8 || e == enc::BAYER_RGGB16) return cv::COLOR_BayerBG2BGR;
+  if (e == enc::BAYER_BGGR8 || e == enc::BAYER_BGGR16) return cv::COLOR_BayerRG2BGR;
+  if (e == enc::BAYER_GBRG8 || e == enc::BAYER_GBRG16) return cv::COLOR_BayerGR2BGR;
+  return cv::COLOR_BayerGB2BGR;  // GRBG
+}
+
+}  // namespace
+
 steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
   using steadiface::Status;
   namespace enc = sensor_msgs::image_encodings;
@@ -105,10 +137,7 @@ steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
                          std::to_string(msg.height));
   }
   int channels = 0, depth = 0;
-  try {
-    channels = enc::numChannels(msg.encoding);
-    depth = enc::bitDepth(msg.encoding);
-  } catch (const std::exception&) {
+  if (!PixelLayout(msg.encoding, &channels, &depth)) {
     return Status::Error("image: unknown encoding '" + msg.encoding + "'");
   }
   const uint64_t min_step = static_cast<uint64_t>(msg.width) * channels * (depth / 8);
@@ -120,32 +149,128 @@ steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
     return Status::Error("image: data has " + std::to_string(msg.data.size()) + " bytes, step * height is " +
                          std::to_string(static_cast<uint64_t>(msg.step) * msg.height));
   }
-  const bool bigendian_mismatch = depth > 8 && msg.is_bigendian;
   const std::string& e = msg.encoding;
-  if (!bigendian_mismatch && (e == enc::MONO8 || e == enc::BGR8 || e == enc::BGRA8 ||
-                              e == enc::TYPE_8UC1 || e == enc::TYPE_8UC3 || e == enc::TYPE_8UC4)) {
-    const int type = CV_MAKETYPE(CV_8U, channels);
-    // Wraps the message's memory (const_cast: we never write to it).
-    *image = cv::Mat(msg.height, msg.width, type, const_cast<uint8_t*>(msg.data.data()), msg.step);
+  // Float and signed images are depth maps or processed data, not a
+  // camera's picture: refuse them rather than stabilize a false rendering.
+  if (e.find("32F") != std::string::npos || e.find("64F") != std::string::npos ||
+      e.find("8S") != std::string::npos || e.find("16S") != std::string::npos ||
+      e.find("32S") != std::string::npos) {
+    return Status::Error("image: encoding '" + e +
+                         "' is a float or signed image (a depth map?), not a camera picture; "
+                         "supported: mono8/16, bgr8, rgb8, bgra8, rgba8, yuv422 (UYVY), "
+                         "yuyv/yuv422_yuy2, bayer_*8/16, and compressed via image_transport");
+  }
+  const bool bigendian_mismatch = depth > 8 && msg.is_bigendian;
+  if (bigendian_mismatch) {
+    return Status::Error("image: big-endian " + e + " is not supported (is_bigendian set)");
+  }
+  uint8_t* data = const_cast<uint8_t*>(msg.data.data());  // never written to
+  if (e == enc::MONO8 || e == enc::BGR8 || e == enc::BGRA8 || e == enc::TYPE_8UC1 ||
+      e == enc::TYPE_8UC3 || e == enc::TYPE_8UC4) {
+    // Wraps the message's memory.
+    *image = cv::Mat(msg.height, msg.width, CV_MAKETYPE(CV_8U, channels), data, msg.step);
     return Status::Ok();
   }
-  if (e == enc::RGB8 || e == enc::RGBA8) {
-    const cv::Mat src(msg.height, msg.width, CV_MAKETYPE(CV_8U, channels),
-                      const_cast<uint8_t*>(msg.data.data()), msg.step);
-    cv::cvtColor(src, *image, e == enc::RGB8 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGR);
-    return Status::Ok();
-  }
-  // Anything cv_bridge converts cleanly (bayer, yuv422, 16-bit, ...).
   try {
+    if (e == enc::RGB8 || e == enc::RGBA8) {
+      const cv::Mat src(msg.height, msg.width, CV_MAKETYPE(CV_8U, channels), data, msg.step);
+      cv::cvtColor(src, *image, e == enc::RGB8 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGR);
+      return Status::Ok();
+    }
+    if (channels == 2 && depth == 8 &&
+        (e == enc::YUV422 || e == "uyvy" || e == "yuyv" || e == "yuv422_yuy2")) {
+      // USB cameras: 4:2:2, two pixels share U and V. yuv422 is UYVY.
+      if (msg.width % 2 != 0) return Status::Error("image: " + e + " needs an even width");
+      const cv::Mat src(msg.height, msg.width, CV_8UC2, data, msg.step);
+      const bool uyvy = e == enc::YUV422 || e == "uyvy";
+      cv::cvtColor(src, *image, uyvy ? cv::COLOR_YUV2BGR_UYVY : cv::COLOR_YUV2BGR_YUYV);
+      return Status::Ok();
+    }
+    if (enc::isBayer(e)) {
+      // Demosaiced to colour (not to grey: the colour is there).
+      if (msg.width < 2 || msg.height < 2) return Status::Error("image: bayer image below 2x2");
+      const cv::Mat src(msg.height, msg.width, depth == 16 ? CV_16UC1 : CV_8UC1, data, msg.step);
+      cv::Mat bgr;
+      cv::cvtColor(src, bgr, BayerToBgrCode(e));
+      if (depth == 16) {
+        bgr.convertTo(*image, CV_8U, 255.0 / 65535.0);
+      } else {
+        *image = bgr;
+      }
+      return Status::Ok();
+    }
+    if (depth == 16 && (channels == 1 || channels == 3 || channels == 4)) {
+      // mono16, 16UC1, bgr16, rgb16, ...: full 16-bit range -> 8 bits.
+      const cv::Mat src(msg.height, msg.width, CV_MAKETYPE(CV_16U, channels), data, msg.step);
+      cv::Mat scaled;
+      src.convertTo(scaled, CV_8U, 255.0 / 65535.0);
+      if (channels == 1) {
+        *image = scaled;
+      } else if (e == enc::RGB16 || e == enc::RGBA16) {
+        cv::cvtColor(scaled, *image, channels == 3 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGR);
+      } else if (channels == 3) {
+        *image = scaled;
+      } else {
+        cv::cvtColor(scaled, *image, cv::COLOR_BGRA2BGR);
+      }
+      return Status::Ok();
+    }
+    // Anything else cv_bridge converts cleanly.
     cv_bridge::CvImageConstPtr cv = cv_bridge::toCvCopy(msg, channels == 1 && depth == 8 ? enc::MONO8 : enc::BGR8);
     *image = cv->image;
     return Status::Ok();
   } catch (const cv_bridge::Exception& ex) {
     return Status::Error("image: unsupported encoding '" + e + "' (" + ex.what() +
-                         "); supported: mono8, bgr8, rgb8, bgra8, rgba8 and what cv_bridge converts");
+                         "); supported: mono8/16, bgr8, rgb8, bgra8, rgba8, yuv422 (UYVY), "
+                         "yuyv/yuv422_yuy2, bayer_*8/16, and compressed via image_transport");
   } catch (const cv::Exception& ex) {
     return Status::Error("image: conversion of '" + e + "' failed: " + ex.what());
   }
+}
+
+steadiface::Status FromCompressedImage(const sensor_msgs::CompressedImage& msg,
+                                       sensor_msgs::ImagePtr* out) {
+  using steadiface::Status;
+  const std::string& f = msg.format;
+  if (f.find("compressedDepth") != std::string::npos) {
+    return Status::Error("compressed image: format '" + f +
+                         "' is a compressed depth map, not a camera picture");
+  }
+  const bool jpeg = f.find("jpeg") != std::string::npos || f.find("jpg") != std::string::npos;
+  const bool png = f.find("png") != std::string::npos;
+  if (!jpeg && !png) {
+    return Status::Error("compressed image: format '" + f + "' is neither jpeg nor png");
+  }
+  if (msg.data.empty()) return Status::Error("compressed image: no data");
+  cv::Mat decoded;
+  try {
+    decoded = cv::imdecode(cv::Mat(1, static_cast<int>(msg.data.size()), CV_8UC1,
+                                   const_cast<uint8_t*>(msg.data.data())),
+                           cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& ex) {
+    decoded.release();
+  }
+  if (decoded.empty()) {
+    return Status::Error("compressed image: cannot decode the " + std::string(jpeg ? "jpeg" : "png") +
+                         " payload (" + std::to_string(msg.data.size()) + " bytes)");
+  }
+  if (decoded.cols > 16384 || decoded.rows > 16384) {
+    return Status::Error("compressed image: implausible size " + std::to_string(decoded.cols) +
+                         "x" + std::to_string(decoded.rows));
+  }
+  namespace enc = sensor_msgs::image_encodings;
+  std::string encoding;
+  if (decoded.depth() == CV_16U) {
+    encoding = decoded.channels() == 1 ? enc::MONO16 : decoded.channels() == 3 ? enc::BGR16 : enc::BGRA16;
+  } else if (decoded.depth() == CV_8U) {
+    encoding = decoded.channels() == 1 ? enc::MONO8 : decoded.channels() == 3 ? enc::BGR8 : enc::BGRA8;
+  } else {
+    return Status::Error("compressed image: decoded to an unsupported pixel type");
+  }
+  // The decoder gives BGR; a "rgb8; jpeg compressed bgr8" producer encoded
+  // BGR too (compressed_image_transport converts before encoding).
+  *out = cv_bridge::CvImage(msg.header, encoding, decoded).toImageMsg();
+  return Status::Ok();
 }
 
 sensor_msgs::CameraInfo ToCameraInfo(const steadiface::CameraIntrinsics& k,

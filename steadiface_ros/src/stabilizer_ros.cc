@@ -86,11 +86,32 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   // 4. Subscribers: IMU never lazy, with a large queue.
   imu_sub_ = nh_.subscribe("imu", 2000, &StabilizerRos::OnImu, this,
                            ros::TransportHints().tcpNoDelay());
-  if (info_source_->has_file_info()) {
-    image_only_sub_ = it_->subscribe("image_raw", 5, &StabilizerRos::OnImageOnly, this);
+  // ~image_transport (raw | compressed | ...), read from this node's private
+  // namespace (not the nodelet manager's). Debian 12 ships no
+  // compressed_image_transport plugin: without it, "compressed" subscribes
+  // to image_raw/compressed and decodes with the built-in jpeg/png decoder.
+  std::string transport = "raw";
+  pnh_.param<std::string>("image_transport", transport, "raw");
+  bool plugin = transport == "raw";
+  for (const std::string& t : it_->getLoadableTransports()) {
+    plugin = plugin || t == transport || t == "image_transport/" + transport;
+  }
+  const bool builtin_compressed = !plugin && transport == "compressed";
+  if (!plugin && !builtin_compressed) {
+    ROS_ERROR("[%s] image_transport '%s' is not installed (have: raw%s); using raw",
+              name_.c_str(), transport.c_str(), ", compressed (built-in)");
+    transport = "raw";
+  }
+  const image_transport::TransportHints hints(builtin_compressed ? "raw" : transport,
+                                              ros::TransportHints(), pnh_);
+  if (builtin_compressed) {
+    compressed_sub_ = nh_.subscribe("image_raw/compressed", 5, &StabilizerRos::OnCompressed, this);
+    info_sub_ = nh_.subscribe("camera_info", 5, &StabilizerRos::OnCameraInfo, this);
+  } else if (info_source_->has_file_info()) {
+    image_only_sub_ = it_->subscribe("image_raw", 5, &StabilizerRos::OnImageOnly, this, hints);
     info_sub_ = nh_.subscribe("camera_info", 5, &StabilizerRos::OnCameraInfo, this);
   } else {
-    image_sub_ = it_->subscribeCamera("image_raw", 5, &StabilizerRos::OnImage, this);
+    image_sub_ = it_->subscribeCamera("image_raw", 5, &StabilizerRos::OnImage, this, hints);
   }
   if (pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal) {
     landmarks_sub_ = nh_.subscribe("landmarks_in", 10, &StabilizerRos::OnLandmarks, this);
@@ -98,8 +119,10 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   timer_ = nh_.createTimer(ros::Duration(0.01), &StabilizerRos::OnTimer, this);
   last_imu_wall_ = ros::WallTime::now();
   ok_ = true;
-  ROS_INFO("[%s] ready: image_raw + camera_info -> image_stabilized, imu, landmark source %s",
-           name_.c_str(),
+  ROS_INFO("[%s] ready: image_raw (%s%s) + %s -> image_stabilized, imu, landmark source %s",
+           name_.c_str(), transport.c_str(), builtin_compressed ? ", built-in decoder" : "",
+           info_source_->has_file_info() ? ("camera_info or " + info_source_->url()).c_str()
+                                         : "camera_info",
            pipeline_options_.landmark_source == steadiface::LandmarkSource::kDlib
                ? "dlib"
                : pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal
@@ -112,6 +135,7 @@ StabilizerRos::~StabilizerRos() {
   timer_.stop();
   image_sub_.shutdown();
   image_only_sub_.shutdown();
+  compressed_sub_.shutdown();
   info_sub_.shutdown();
   imu_sub_.shutdown();
   landmarks_sub_.shutdown();
@@ -134,6 +158,19 @@ void StabilizerRos::OnImageOnly(const sensor_msgs::ImageConstPtr& image) {
   // Null (size mismatch, reported by the source): the wrapper counts the
   // frame as dropped for its camera_info.
   wrapper_->OnImage(image, info_source_->Select(*image, from_message), ros::Time::now());
+}
+
+void StabilizerRos::OnCompressed(const sensor_msgs::CompressedImageConstPtr& msg) {
+  sensor_msgs::ImagePtr image;
+  const steadiface::Status s = FromCompressedImage(*msg, &image);
+  if (!s.ok()) {
+    ++decode_failures_;
+    image_freq_->tick();
+    Error("compressed", s.message() + " (frame skipped; " + std::to_string(decode_failures_) +
+                            " so far)");
+    return;
+  }
+  OnImageOnly(image);
 }
 
 void StabilizerRos::OnCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {

@@ -12,10 +12,12 @@
 
 #include <camera_calibration_parsers/parse.h>
 #include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <ros/package.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/image_encodings.h>
 
@@ -31,6 +33,7 @@ int Usage() {
                "  [--clock-offset S] [--readout S] [--epoch S] [--no-face] [--hfov RAD]\n"
                "  [--image-topic T] [--info-topic T|none] [--imu-topic T]\n"
                "  [--camera-frame F] [--imu-frame F]\n"
+               "  [--compress-images jpeg|png: sensor_msgs/CompressedImage on <image-topic>/compressed]\n"
                "  [--imu-rotation qx,qy,qz,qw: the IMU's mounting, R_imu_cam; the gyro is\n"
                "   recorded in IMU axes, so the stabilizer needs imu/R_cam_imu = its inverse]\n"
                "  [--calibration-out FILE.yaml: the camera's intrinsics as a camera_calibration\n"
@@ -49,7 +52,7 @@ int main(int argc, char** argv) {
   double readout = -1;
   std::string image_topic = "/camera/image_raw", info_topic = "/camera/camera_info",
               imu_topic = "/imu", camera_frame = "camera_optical", imu_frame = "camera_optical",
-              calibration_out;
+              calibration_out, compress_images;
   Eigen::Quaterniond R_imu_cam = Eigen::Quaterniond::Identity();
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -77,6 +80,10 @@ int main(int argc, char** argv) {
     else if (a == "--camera-frame") camera_frame = next();
     else if (a == "--imu-frame") imu_frame = next();
     else if (a == "--calibration-out") calibration_out = next();
+    else if (a == "--compress-images") {
+      compress_images = next();
+      if (compress_images != "jpeg" && compress_images != "png") return Usage();
+    }
     else if (a == "--imu-rotation") {
       double x, y, z, w;
       if (std::sscanf(next().c_str(), "%lf,%lf,%lf,%lf", &x, &y, &z, &w) != 4) return Usage();
@@ -156,7 +163,18 @@ int main(int argc, char** argv) {
     h.stamp = stamp;
     h.frame_id = camera_frame;
     h.seq = i;
-    bag.write(image_topic, last_row, cv_bridge::CvImage(h, enc, img).toImageMsg());
+    if (compress_images.empty()) {
+      bag.write(image_topic, last_row, cv_bridge::CvImage(h, enc, img).toImageMsg());
+    } else {
+      // As compressed_image_transport publishes it.
+      sensor_msgs::CompressedImage c;
+      c.header = h;
+      c.format = enc + "; " + compress_images + " compressed " + enc;
+      cv::imencode(compress_images == "jpeg" ? ".jpg" : ".png", img, c.data,
+                   {compress_images == "jpeg" ? cv::IMWRITE_JPEG_QUALITY : cv::IMWRITE_PNG_COMPRESSION,
+                    compress_images == "jpeg" ? 95 : 3});
+      bag.write(image_topic + "/compressed", last_row, c);
+    }
     if (info_topic != "none") bag.write(info_topic, last_row, steadiface_ros::ToCameraInfo(k, h));
     csv << i << "," << stamp.toSec() << "," << truth.head_px.x() << "," << truth.head_px.y() << ","
         << truth.head_in_view << "," << truth.face_scale_px << "," << truth.occluded << ","

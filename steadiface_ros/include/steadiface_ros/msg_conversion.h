@@ -3,6 +3,7 @@
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Transform.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 
@@ -40,10 +41,21 @@ geometry_msgs::Transform ToTransformMsg(const Eigen::Quaterniond& q);
 
 /// Validates an image message before touching its memory (encoding, size,
 /// step, data length) and wraps or converts it to an 8-bit cv::Mat: mono8
-/// stays 1 channel, bgr8 stays 3, bgra8 4; rgb8/rgba8 and anything else
-/// cv_bridge converts cleanly become bgr8. `*image` may share the message's
-/// memory: keep the message alive while using it.
+/// stays 1 channel, bgr8 stays 3, bgra8 4; rgb8/rgba8 become bgr8;
+/// yuv422 (UYVY) and yuyv / yuv422_yuy2 (YUYV) become bgr8; bayer_*8/16 are
+/// demosaiced to bgr8; 16-bit images (mono16, bgr16, ...) are scaled from
+/// their full range to 8 bits. Float and signed images (depth maps) are
+/// refused with a message naming the encoding. `*image` may share the
+/// message's memory: keep the message alive while using it.
 steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image);
+
+/// sensor_msgs/CompressedImage (jpeg or png, as compressed_image_transport
+/// publishes it on <image>/compressed) -> a decoded image message with the
+/// same header: mono8/bgr8/bgra8, or mono16/bgr16 for a 16-bit png. A
+/// compressedDepth payload, an unknown format or undecodable data is an
+/// error naming it.
+steadiface::Status FromCompressedImage(const sensor_msgs::CompressedImage& msg,
+                                       sensor_msgs::ImagePtr* out);
 
 /// Output camera_info for the stabilized image: the virtual intrinsics,
 /// no distortion, identity R, P = [K | 0].

@@ -11,6 +11,7 @@
 #include <dynamic_reconfigure/server.h>
 #include <image_transport/image_transport.h>
 #include <ros/ros.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Imu.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -61,9 +62,11 @@ class StabilizerRos : public OutputSink {
  private:
   void OnImage(const sensor_msgs::ImageConstPtr& image,
                const sensor_msgs::CameraInfoConstPtr& info);
-  // With camera_info_url: images and camera_info subscribed separately; a
+  // With camera_info_url, or compressed images without the
+  // image_transport plugin: images and camera_info subscribed separately; a
   // camera_info message within 0.5 s of the image wins over the file.
   void OnImageOnly(const sensor_msgs::ImageConstPtr& image);
+  void OnCompressed(const sensor_msgs::CompressedImageConstPtr& msg);
   void OnCameraInfo(const sensor_msgs::CameraInfoConstPtr& info);
   void OnImu(const sensor_msgs::ImuConstPtr& msg);
   void OnLandmarks(const steadiface::FaceLandmarksConstPtr& msg);
@@ -100,6 +103,8 @@ class StabilizerRos : public OutputSink {
   std::unique_ptr<CameraInfoSource> info_source_;
   image_transport::Subscriber image_only_sub_;  // camera_info_url mode
   ros::Subscriber info_sub_;                    // camera_info_url mode
+  ros::Subscriber compressed_sub_;  // built-in jpeg/png decoder (no plugin)
+  uint64_t decode_failures_ = 0;
   sensor_msgs::CameraInfoConstPtr latest_info_;
   ros::Subscriber imu_sub_, landmarks_sub_;
   ros::Timer timer_;

@@ -63,6 +63,8 @@ int Usage() {
          "  [--start-stamp S: skip images stamped before S (IMU is still read)]\n"
          "  [--only-stamps FILE: process only the images whose stamps [s] are listed,\n"
          "   one per line (to replay exactly the frames a live run received)]\n"
+         "The image topic may hold sensor_msgs/CompressedImage (jpeg/png, e.g.\n"
+         "--image camera/image_raw/compressed); it is decoded on the reader thread.\n"
          "Intrinsics come from the bag's camera_info topic or, when the bag has none,\n"
          "from the camera_info_url parameter (file://, package:// or a path to a\n"
          "camera_calibration YAML/INI) in a --params file.\n";
@@ -147,7 +149,13 @@ int main(int argc, char** argv) {
   sink.debug = (a.debug_overlay && !a.video.empty()) || (a.debug_images_in_bag && !a.out.empty());
   sink.debug_to_bag = a.debug_images_in_bag;
   {
-    const std::string img = steadiface_bag::NormalizeTopic(a.topics.image);
+    std::string img = steadiface_bag::NormalizeTopic(a.topics.image);
+    // camera/image_raw/compressed publishes as camera/image_stabilized/...
+    const std::string suffix = "/compressed";
+    if (reader.compressed() && img.size() > suffix.size() &&
+        img.compare(img.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      img.resize(img.size() - suffix.size());
+    }
     const size_t slash = img.rfind('/');
     sink.ns = slash == 0 || slash == std::string::npos ? "" : img.substr(0, slash);
   }
@@ -223,6 +231,10 @@ int main(int argc, char** argv) {
     if (writer) writer->Finish();
     if (!a.out.empty()) std::remove(out_tmp.c_str());
     return 1;
+  }
+  if (reader.decode_failures() > 0) {
+    std::cerr << "steadiface_bag: " << reader.decode_failures()
+              << " compressed images did not decode and were skipped\n";
   }
   wrapper.Flush();
   video.AddOutput(&sink);

@@ -4,6 +4,9 @@
 #include <map>
 
 #include <rosbag/view.h>
+#include <sensor_msgs/CompressedImage.h>
+
+#include "steadiface_ros/msg_conversion.h"
 
 namespace steadiface_bag {
 
@@ -47,6 +50,8 @@ steadiface::Status BagReader::Open(bool info_required) {
       }
       if (w.second != "sensor_msgs/Imu") return Status::Error("no image topic");
       std::cerr << "steadiface_bag: continuing without IMU: frames pass through unstabilized\n";
+    } else if (w.second == "sensor_msgs/Image" && it->second == "sensor_msgs/CompressedImage") {
+      compressed_ = true;
     } else if (it->second != w.second) {
       return Status::Error("topic '" + NormalizeTopic(w.first) + "' has type " + it->second +
                            ", expected " + w.second);
@@ -89,8 +94,19 @@ void BagReader::Start(BoundedQueue<BagItem>* queue) {
           item.info = m.instantiate<sensor_msgs::CameraInfo>();
         } else if (topic == landmarks) {
           item.landmarks = m.instantiate<steadiface::FaceLandmarks>();
-        } else if (topic == image) {
+        } else if (topic == image && !compressed_) {
           item.image = m.instantiate<sensor_msgs::Image>();
+        } else if (topic == image) {
+          sensor_msgs::CompressedImageConstPtr c = m.instantiate<sensor_msgs::CompressedImage>();
+          sensor_msgs::ImagePtr decoded;
+          const steadiface::Status s =
+              c ? steadiface_ros::FromCompressedImage(*c, &decoded)
+                : steadiface::Status::Error("not a sensor_msgs/CompressedImage");
+          if (s.ok()) {
+            item.image = decoded;
+          } else if (decode_failures_++ == 0) {
+            std::cerr << "steadiface_bag: " << s.message() << " (frame skipped)\n";
+          }
         }
         if (!queue->Push(std::move(item))) break;
       }

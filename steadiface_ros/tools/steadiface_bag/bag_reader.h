@@ -28,7 +28,8 @@ struct BagTopics {
 };
 
 /// One decoded bag message: exactly one pointer is set for the topics the
-/// tool reads (none for a message whose type did not instantiate).
+/// tool reads (none for a message whose type did not instantiate, or a
+/// compressed image that did not decode).
 struct BagItem {
   ros::Time time;
   sensor_msgs::ImuConstPtr imu;
@@ -53,6 +54,11 @@ class BagReader {
   steadiface::Status Open(bool info_required);
   /// Whether the bag has the camera_info topic.
   bool has_info() const { return has_info_; }
+  /// The image topic holds sensor_msgs/CompressedImage (jpeg/png, decoded
+  /// on the reader thread).
+  bool compressed() const { return compressed_; }
+  /// Compressed images that did not decode (read after Join).
+  size_t decode_failures() const { return decode_failures_; }
   /// Number of messages on the image topic.
   size_t ImageCount() const;
   /// Starts the reader thread; it closes `queue` at the end or on error.
@@ -68,6 +74,8 @@ class BagReader {
   const BagTopics topics_;
   rosbag::Bag bag_;
   bool has_info_ = false;
+  bool compressed_ = false;
+  size_t decode_failures_ = 0;  // written by the reader thread, read after join
   std::thread thread_;
   std::string error_;  // written by the reader thread, read after join
 };
