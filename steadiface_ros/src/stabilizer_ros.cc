@@ -57,6 +57,7 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   landmarks_pub_ = nh_.advertise<steadiface::FaceLandmarks>("face_landmarks", 10);
   state_pub_ = nh_.advertise<steadiface::StabilizerState>("state", 10);
   head_target_pub_ = nh_.advertise<geometry_msgs::PointStamped>("head_target", 10);
+  frusta_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("frusta", 2);
 
   // Diagnostics.
   updater_.reset(new diagnostic_updater::Updater(nh_, pnh_, name_));
@@ -231,6 +232,10 @@ void StabilizerRos::PublishTf(const std::vector<geometry_msgs::TransformStamped>
 }
 void StabilizerRos::PublishHeadTarget(const geometry_msgs::PointStamped& p) {
   head_target_pub_.publish(p);
+}
+bool StabilizerRos::WantsMarkers() const { return frusta_pub_.getNumSubscribers() > 0; }
+void StabilizerRos::PublishMarkers(const visualization_msgs::MarkerArray& m) {
+  frusta_pub_.publish(m);
 }
 bool StabilizerRos::WantsDebugImage() const { return debug_pub_.getNumSubscribers() > 0; }
 void StabilizerRos::PublishDebugImage(const sensor_msgs::ImagePtr& image) {

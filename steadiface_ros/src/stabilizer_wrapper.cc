@@ -73,6 +73,7 @@ void StabilizerWrapper::ResetAll(const char* why) {
   last_frame_stamp_ = ros::Time();
   last_tf_stamp_ = ros::Time();
   have_last_imu_ = false;
+  frusta_.Clear();
   sink_->OnTimeJump();
 }
 
@@ -356,6 +357,15 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
       last_tf_stamp_ = in_header.stamp;
     } else {
       ++counters_.tf_skipped;
+    }
+    // rviz frusta: camera -> world orientations are the inverses of R_r, R_v.
+    frusta_.Add(frame.stabilizer.R_r.conjugate(), frame.stabilizer.R_v.conjugate());
+    if (sink_->WantsMarkers()) {
+      std_msgs::Header world_header = in_header;
+      world_header.frame_id = wrapper_options_.world_frame;
+      const visualization_msgs::MarkerArray m = frusta_.Make(
+          world_header, pipeline_->camera_model().intrinsics(), frame.output_intrinsics);
+      if (!m.markers.empty()) sink_->PublishMarkers(m);
     }
     if (frame.stabilizer.has_target) {
       // H's ray in the virtual camera: K_v(t)^-1 [H; 1].

@@ -52,6 +52,8 @@ class StabilizerRos : public OutputSink {
   void PublishState(const steadiface::StabilizerState& msg) override;
   void PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) override;
   void PublishHeadTarget(const geometry_msgs::PointStamped& p) override;
+  bool WantsMarkers() const override;
+  void PublishMarkers(const visualization_msgs::MarkerArray& m) override;
   bool WantsDebugImage() const override;
   void PublishDebugImage(const sensor_msgs::ImagePtr& image) override;
   void Warn(const std::string& key, const std::string& text) override;
@@ -94,7 +96,7 @@ class StabilizerRos : public OutputSink {
   std::unique_ptr<image_transport::ImageTransport> it_;
   image_transport::CameraPublisher image_pub_;
   image_transport::Publisher debug_pub_;
-  ros::Publisher landmarks_pub_, state_pub_, head_target_pub_;
+  ros::Publisher landmarks_pub_, state_pub_, head_target_pub_, frusta_pub_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;

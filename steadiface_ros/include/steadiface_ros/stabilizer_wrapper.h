@@ -13,10 +13,12 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "steadiface/FaceLandmarks.h"
 #include "steadiface/StabilizerState.h"
 #include "steadiface_core/pipeline.h"
+#include "steadiface_ros/frusta_markers.h"
 #include "steadiface_ros/params.h"
 
 namespace steadiface_ros {
@@ -34,6 +36,10 @@ class OutputSink {
   /// The target head centre H as a 3D point 1 m along its ray, in the
   /// stabilized camera's frame (for rviz).
   virtual void PublishHeadTarget(const geometry_msgs::PointStamped& /*p*/) {}
+  /// The real and virtual cameras as rviz frusta with trails (FrustaMarkers),
+  /// built only when this returns true (a viewer is subscribed).
+  virtual bool WantsMarkers() const { return false; }
+  virtual void PublishMarkers(const visualization_msgs::MarkerArray& /*m*/) {}
   /// Debug images are rendered only when this returns true.
   virtual bool WantsDebugImage() const = 0;
   virtual void PublishDebugImage(const sensor_msgs::ImagePtr& image) = 0;
@@ -151,6 +157,7 @@ class StabilizerWrapper {
   bool extrinsic_resolved_ = false;
   std::deque<steadiface::GyroSample> recent_gyro_;  // bounded, for rebuilds
   std::deque<Pending> queue_;                       // bounded by frame_queue_size
+  FrustaMarkers frusta_;                            // bounded trails
   std::vector<Eigen::Vector2d> external_landmarks_;
   double external_confidence_ = 0.0;
   ros::Time last_external_stamp_;
