@@ -97,32 +97,82 @@ Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
 }
 
 void Stabilizer::reset() {
-  history_ = 0;
-  has_H_ = false;
+  subject_ = LayerState();
   has_held_face_ = false;
   dynamic_.reset();
   ++stats_.resets;
 }
+
+// One frame's Eq. 5 problem: the parameter blocks and each term's residual
+// blocks, kept after the solve to evaluate the energies at the final pose.
+struct Stabilizer::PoseProblem {
+  double q_block[4];
+  double t_block[2];
+  ceres::Problem problem;
+  std::vector<ceres::ResidualBlockId> b_fit, b_dist, b_follow, b_rot, b_trans, b_prot;
+  Eigen::Map<Eigen::Vector4d> q() { return Eigen::Map<Eigen::Vector4d>(q_block); }
+  Eigen::Map<Eigen::Vector2d> t() { return Eigen::Map<Eigen::Vector2d>(t_block); }
+};
 
 Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
                            const RowTiming& timing,
                            const FaceObservation* face,
                            StabilizerFrame* frame) {
   const auto start = Clock::now();
-  if (history_ > 0 && stamp <= last_stamp_) {
+  LayerState& layer = subject_;
+  StabilizerFrame f;
+  double dt = 0.0;
+  Status s = RowRotationsStep(stamp, timeline, timing, layer, &f, &dt);
+  if (!s.ok()) return s;
+
+  const bool use_face = FaceUsable(face, options_);
+  const StabilizerWeights w =
+      DynamicWeightsStep(stamp, timeline, layer, use_face ? face : nullptr, dt, &f);
+
+  Eigen::Quaterniond R_v0;
+  Eigen::Vector2d t0;
+  InitialPoseStep(layer, f, &R_v0, &t0);
+
+  FaceObservation held;
+  const FaceObservation* fit_face = HeldFaceStep(layer, use_face ? face : nullptr, w, &held, &f);
+
+  HeadTargetStep(layer, fit_face, use_face, w, R_v0, t0, &f);
+
+  PoseProblem problem;
+  Eigen::Quaterniond R_v = R_v0;
+  Eigen::Vector2d t = t0;
+  SolveStep(stamp, timeline, timing, layer, fit_face, w, dt, &problem, &R_v, &t, &f);
+
+  ProtrusionStep(layer, &R_v, &t, &f);
+
+  EnergiesStep(R_v, t, &problem, &f);
+  f.R_v = R_v;
+  f.t = t;
+
+  AdvanceStep(stamp, &layer, f);
+  ++stats_.frames;
+  if (use_face) ++stats_.frames_with_face;
+  f.timings.total_ms = MsSince(start);
+  *frame = std::move(f);
+  return Status::Ok();
+}
+
+Status Stabilizer::RowRotationsStep(Time stamp, const OrientationTimeline& timeline,
+                                    const RowTiming& timing, const LayerState& layer,
+                                    StabilizerFrame* f, double* dt) {
+  if (layer.history > 0 && stamp <= layer.last_stamp) {
     std::ostringstream err;
     err << "frame stamp " << ToSeconds(stamp)
-        << " s is not after the previous one (" << ToSeconds(last_stamp_)
+        << " s is not after the previous one (" << ToSeconds(layer.last_stamp)
         << " s); reset() the stabilizer after a time jump";
     return Status::Error(err.str());
   }
   if (timing.height() != model_.intrinsics().height) {
     return Status::Error("row timing is for another image height");
   }
-  StabilizerFrame f;
-  f.stamp = stamp;
+  f->stamp = stamp;
   const QueryResult q = RowRotations::Build(
-      timeline, timing, stamp, options_.row_rotation_samples, &f.rows);
+      timeline, timing, stamp, options_.row_rotation_samples, &f->rows);
   if (!QuerySucceeded(q)) {
     ++stats_.no_gyro_frames;
     return Status::Error(
@@ -130,14 +180,19 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
         std::to_string(ToSeconds(timing.FirstRowTime(stamp))) + " s, last row " +
         std::to_string(ToSeconds(timing.LastRowTime(stamp))) + " s)");
   }
-  f.R_r = f.rows.Middle();
-  if (history_ > 0) f.R_r = AlignSign(f.R_r, R_r_prev_);
-  const double dt = history_ > 0 ? ToSeconds(stamp - last_stamp_) : 0.0;
-  f.flags.first_frame = history_ == 0;
+  f->R_r = f->rows.Middle();
+  if (layer.history > 0) f->R_r = AlignSign(f->R_r, layer.R_r_prev);
+  *dt = layer.history > 0 ? ToSeconds(stamp - layer.last_stamp) : 0.0;
+  f->flags.first_frame = layer.history == 0;
+  return Status::Ok();
+}
 
-  // Dynamic weights (§4.4).
+StabilizerWeights Stabilizer::DynamicWeightsStep(Time stamp, const OrientationTimeline& timeline,
+                                                 const LayerState& layer,
+                                                 const FaceObservation* face, double dt,
+                                                 StabilizerFrame* f) {
+  // Dynamic weights (§4.4). `face` is null unless usable.
   const auto t_weights = Clock::now();
-  const bool use_face = FaceUsable(face, options_);
   double mean_speed = -1.0;
   if (!timeline.MeanAngularSpeed(
           stamp - FromSeconds(options_.dynamic.gyro_window_s), stamp,
@@ -146,138 +201,153 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   }
   // A camera fixed in the world at the epoch's first real rotation: what
   // it sees does not depend on where the gyro integration started.
-  if (history_ == 0) R_reference_ = f.R_r;
+  if (layer.history == 0) R_reference_ = f->R_r;
   Eigen::Vector2d stabilized_centre = Eigen::Vector2d::Zero();
-  if (use_face) {
-    model_.Project(face->centre, R_reference_, Eigen::Vector2d::Zero(), f.R_r,
+  if (face != nullptr) {
+    model_.Project(face->centre, R_reference_, Eigen::Vector2d::Zero(), f->R_r,
                    &stabilized_centre);
   }
-  f.factors =
-      dynamic_.Update(dt, mean_speed, use_face ? face : nullptr,
-                      stabilized_centre);
+  f->factors = dynamic_.Update(dt, mean_speed, face, stabilized_centre);
   StabilizerWeights w = options_.weights;
-  w.fit = options_.gyro_only ? 0.0 : w.fit * f.factors.fit;
-  w.rotation_c0 *= f.factors.smoothness;
-  w.rotation_c1 *= f.factors.smoothness;
-  w.translation_c0 *= f.factors.smoothness;
-  w.translation_c1 *= f.factors.smoothness;
-  f.weights = w;
-  f.timings.weights_ms = MsSince(t_weights);
+  w.fit = options_.gyro_only ? 0.0 : w.fit * f->factors.fit;
+  w.rotation_c0 *= f->factors.smoothness;
+  w.rotation_c1 *= f->factors.smoothness;
+  w.translation_c0 *= f->factors.smoothness;
+  w.translation_c1 *= f->factors.smoothness;
+  f->weights = w;
+  f->timings.weights_ms = MsSince(t_weights);
+  return w;
+}
 
+void Stabilizer::InitialPoseStep(const LayerState& layer, const StabilizerFrame& f,
+                                 Eigen::Quaterniond* R_v0, Eigen::Vector2d* t0) const {
   // Initial pose (paper Eq. 12): identity-equivalent (virtual = real) on the
   // first frame, then the real rotation change applied to the previous
   // virtual rotation, and the previous offset.
-  Eigen::Quaterniond R_v0 = f.R_r;
-  Eigen::Vector2d t0 = Eigen::Vector2d::Zero();
-  if (history_ > 0) {
-    R_v0 = AlignSign(((f.R_r * R_r_prev_.conjugate()) * R_v_prev_).normalized(),
-                     R_v_prev_);
-    t0 = t_prev_;
+  *R_v0 = f.R_r;
+  *t0 = Eigen::Vector2d::Zero();
+  if (layer.history > 0) {
+    *R_v0 = AlignSign(((f.R_r * layer.R_r_prev.conjugate()) * layer.R_v_prev).normalized(),
+                      layer.R_v_prev);
+    *t0 = layer.t_prev;
   }
+}
 
-  // The face the fitting term uses: this frame's, or while w_f fades out
-  // after a loss, the last one held fixed in the world.
-  const FaceObservation* fit_face = use_face ? face : nullptr;
-  FaceObservation held;
-  if (!use_face && has_held_face_ && has_H_ && w.fit > 1e-3 * options_.weights.fit) {
-    held = held_face_;
+const FaceObservation* Stabilizer::HeldFaceStep(const LayerState& layer,
+                                                const FaceObservation* face,
+                                                const StabilizerWeights& w,
+                                                FaceObservation* held, StabilizerFrame* f) {
+  // The face the fitting term uses: this frame's (`face`, null unless
+  // usable), or while w_f fades out after a loss, the last one held fixed
+  // in the world.
+  const FaceObservation* fit_face = face;
+  if (face == nullptr && has_held_face_ && layer.has_H && w.fit > 1e-3 * options_.weights.fit) {
+    *held = held_face_;
     bool ok = true;
-    for (size_t i = 0; i < held.landmarks.size() && ok; ++i) {
+    for (size_t i = 0; i < held->landmarks.size() && ok; ++i) {
       const Eigen::Quaterniond R_row =
-          held.landmark_rows.empty() ? f.R_r : f.rows.At(held.landmark_rows[i]);
+          held->landmark_rows.empty() ? f->R_r : f->rows.At(held->landmark_rows[i]);
       ok = model_.Unproject(held_face_.landmarks[i], R_reference_, Eigen::Vector2d::Zero(),
-                            R_row, &held.landmarks[i]);
+                            R_row, &held->landmarks[i]);
     }
     if (ok) {
-      ComputeCentreAndScale(&held);
-      fit_face = &held;
-      f.flags.held_face = true;
+      ComputeCentreAndScale(held);
+      fit_face = held;
+      f->flags.held_face = true;
     }
   }
   if (fit_face == nullptr) has_held_face_ = false;
+  return fit_face;
+}
 
+void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face,
+                                bool use_face, const StabilizerWeights& w,
+                                const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
+                                StabilizerFrame* f) {
   // Target head centre (Eq. 1).
   const auto t_smooth = Clock::now();
   if (fit_face != nullptr) {
     const FaceObservation* face = fit_face;
-    f.C = face->centre;
-    if (options_.smooth_head_in_virtual_view && history_ > 0) {
+    f->C = face->centre;
+    if (options_.smooth_head_in_virtual_view && layer.history > 0) {
       // C as the virtual camera would show it if it kept moving smoothly.
       const Eigen::Quaterniond R_pred =
-          history_ >= 2
-              ? ((R_v_prev_ * R_v_prev_prev_.conjugate()) * R_v_prev_).normalized()
-              : R_v_prev_;
-      const Eigen::Vector2d t_pred =
-          history_ >= 2 ? Eigen::Vector2d(2.0 * t_prev_ - t_prev_prev_) : t_prev_;
+          layer.history >= 2
+              ? ((layer.R_v_prev * layer.R_v_prev_prev.conjugate()) * layer.R_v_prev).normalized()
+              : layer.R_v_prev;
+      const Eigen::Vector2d t_pred = layer.history >= 2
+                                         ? Eigen::Vector2d(2.0 * layer.t_prev - layer.t_prev_prev)
+                                         : layer.t_prev;
       Eigen::Vector2d c;
-      if (model_.Project(face->centre, R_pred, t_pred, f.R_r, &c)) f.C = c;
+      if (model_.Project(face->centre, R_pred, t_pred, f->R_r, &c)) f->C = c;
     }
-    if (!has_H_) {
+    Eigen::Vector2d H_prev = layer.H_prev;
+    if (!layer.has_H) {
       // Start where the face appears in the virtual view now: no jump.
       Eigen::Vector2d p;
-      H_prev_ = model_.Project(f.C, R_v0, t0, f.R_r, &p) ? p : f.C;
+      H_prev = model_.Project(f->C, R_v0, t0, f->R_r, &p) ? p : f->C;
     }
-    f.H = smoother_.Solve(H_prev_, f.C, output_.margin());
-    f.has_target = true;
-    f.flags.face_used = use_face && w.fit > 0.0;
+    f->H = smoother_.Solve(H_prev, f->C, output_.margin());
+    f->has_target = true;
+    f->flags.face_used = use_face && w.fit > 0.0;
     if (use_face) {
       // Hold it as a world-fixed camera sees it.
       held_face_ = *face;
       for (size_t i = 0; i < face->landmarks.size(); ++i) {
         const Eigen::Quaterniond R_row =
-            face->landmark_rows.empty() ? f.R_r : f.rows.At(face->landmark_rows[i]);
+            face->landmark_rows.empty() ? f->R_r : f->rows.At(face->landmark_rows[i]);
         model_.Project(face->landmarks[i], R_reference_, Eigen::Vector2d::Zero(), R_row,
                        &held_face_.landmarks[i]);
       }
       has_held_face_ = true;
     }
   }
-  f.timings.smoothing_ms = MsSince(t_smooth);
+  f->timings.smoothing_ms = MsSince(t_smooth);
+}
 
-  // Solve (Eq. 5).
+void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
+                           const RowTiming& timing, const LayerState& layer,
+                           const FaceObservation* fit_face, const StabilizerWeights& w,
+                           double dt, PoseProblem* pp, Eigen::Quaterniond* R_v,
+                           Eigen::Vector2d* t, StabilizerFrame* f) {
+  // Solve (Eq. 5) from the initial pose in *R_v, *t.
   const auto t_solve = Clock::now();
-  Eigen::Quaterniond R_v = R_v0;
-  Eigen::Vector2d t = t0;
-  double q_block[4], t_block[2];
-  Eigen::Map<Eigen::Vector4d> q_map(q_block);
-  Eigen::Map<Eigen::Vector2d> t_map(t_block);
-  q_map = R_v0.coeffs();
-  t_map = t0;
-  ceres::Problem::Options po;
-  ceres::Problem problem(po);
-  problem.AddParameterBlock(q_block, 4, new ceres::EigenQuaternionManifold);
-  problem.AddParameterBlock(t_block, 2);
-  std::vector<ceres::ResidualBlockId> b_fit, b_dist, b_follow, b_rot, b_trans,
-      b_prot;
+  const Eigen::Quaterniond R_v0 = *R_v;
+  const Eigen::Vector2d t0 = *t;
+  pp->q() = R_v0.coeffs();
+  pp->t() = t0;
+  ceres::Problem& problem = pp->problem;
+  problem.AddParameterBlock(pp->q_block, 4, new ceres::EigenQuaternionManifold);
+  problem.AddParameterBlock(pp->t_block, 2);
   const double f_r = model_.real_focal(), f_v = model_.virtual_focal();
-  if (f.has_target && w.fit > 0.0) {
+  if (f->has_target && w.fit > 0.0) {
     const FaceObservation* face = fit_face;
     const double s = std::sqrt(w.fit / face->landmarks.size());
     for (size_t i = 0; i < face->landmarks.size(); ++i) {
       const Eigen::Quaterniond R_row =
           face->landmark_rows.empty()
-              ? f.R_r
-              : AlignSign(f.rows.At(face->landmark_rows[i]), f.R_r);
-      b_fit.push_back(problem.AddResidualBlock(
-          FittingCost::Create(face->landmarks[i], R_row, f.H, f_r, f_v, s),
-          nullptr, q_block, t_block));
+              ? f->R_r
+              : AlignSign(f->rows.At(face->landmark_rows[i]), f->R_r);
+      pp->b_fit.push_back(problem.AddResidualBlock(
+          FittingCost::Create(face->landmarks[i], R_row, f->H, f_r, f_v, s),
+          nullptr, pp->q_block, pp->t_block));
     }
   }
   if (w.distortion > 0.0) {
-    b_dist.push_back(problem.AddResidualBlock(
-        DistortionCost::Create(f.R_r, options_.terms.distortion_threshold_rad,
+    pp->b_dist.push_back(problem.AddResidualBlock(
+        DistortionCost::Create(f->R_r, options_.terms.distortion_threshold_rad,
                                options_.terms.distortion_slope,
                                std::sqrt(w.distortion)),
-        nullptr, q_block));
+        nullptr, pp->q_block));
   }
   if (w.follow > 0.0) {
-    b_follow.push_back(problem.AddResidualBlock(
-        FollowingCost::Create(f.R_r, std::sqrt(w.follow)), nullptr, q_block));
+    pp->b_follow.push_back(problem.AddResidualBlock(
+        FollowingCost::Create(f->R_r, std::sqrt(w.follow)), nullptr, pp->q_block));
   }
-  if (history_ >= 1) {
+  if (layer.history >= 1) {
     const Eigen::Quaterniond prev_delta =
-        (R_v_prev_ * R_v_prev_prev_.conjugate()).normalized();
-    Eigen::Quaterniond c0_target = R_v_prev_;
+        (layer.R_v_prev * layer.R_v_prev_prev.conjugate()).normalized();
+    Eigen::Quaterniond c0_target = layer.R_v_prev;
     if (options_.intentional_window_s > 0.0) {
       // The real camera's mean rotation per frame over the window.
       const double W = options_.intentional_window_s;
@@ -285,35 +355,35 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
       if (QuerySucceeded(timeline.RealRotation(
               timing.RowTime(stamp, 0.5 * (timing.height() - 1)) - FromSeconds(W),
               &R_old))) {
-        const Eigen::Vector3d rate = LogSO3(f.R_r * R_old.conjugate()) / W;
-        c0_target = (ExpSO3(rate * dt) * R_v_prev_).normalized();
+        const Eigen::Vector3d rate = LogSO3(f->R_r * R_old.conjugate()) / W;
+        c0_target = (ExpSO3(rate * dt) * layer.R_v_prev).normalized();
       }
     }
-    b_rot.push_back(problem.AddResidualBlock(
-        RotationSmoothnessCost::Create(c0_target, R_v_prev_, prev_delta, history_ >= 2,
-                                       std::sqrt(w.rotation_c0),
+    pp->b_rot.push_back(problem.AddResidualBlock(
+        RotationSmoothnessCost::Create(c0_target, layer.R_v_prev, prev_delta,
+                                       layer.history >= 2, std::sqrt(w.rotation_c0),
                                        std::sqrt(w.rotation_c1)),
-        nullptr, q_block));
+        nullptr, pp->q_block));
   }
   // On the first frame the offset's only prior is C0 towards 0.
-  b_trans.push_back(problem.AddResidualBlock(
+  pp->b_trans.push_back(problem.AddResidualBlock(
       TranslationSmoothnessCost::Create(
-          history_ >= 1 ? t_prev_ : Eigen::Vector2d::Zero(), t_prev_prev_,
-          history_ >= 2, std::sqrt(w.translation_c0),
+          layer.history >= 1 ? layer.t_prev : Eigen::Vector2d::Zero(), layer.t_prev_prev,
+          layer.history >= 2, std::sqrt(w.translation_c0),
           std::sqrt(w.translation_c1)),
-      nullptr, t_block));
+      nullptr, pp->t_block));
   const double shrink_px =
       options_.terms.protrusion_shrink * model_.intrinsics().width;
   if (w.protrusion > 0.0) {
     const ProtrusionReport at_init =
-        protrusion_.Check(R_v0, t0, f.rows, shrink_px);
+        protrusion_.Check(R_v0, t0, f->rows, shrink_px);
     std::vector<Eigen::Quaterniond> R_samples;
     R_samples.reserve(at_init.rows.size());
-    for (double y : at_init.rows) R_samples.push_back(f.rows.At(y));
-    b_prot.push_back(problem.AddResidualBlock(
+    for (double y : at_init.rows) R_samples.push_back(f->rows.At(y));
+    pp->b_prot.push_back(problem.AddResidualBlock(
         ProtrusionCost::Create(&protrusion_, std::move(R_samples), shrink_px,
                                options_.terms.protrusion_alpha, w.protrusion),
-        nullptr, q_block, t_block));
+        nullptr, pp->q_block, pp->t_block));
   }
 
   ceres::Solver::Options so;
@@ -327,102 +397,106 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   so.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
-  f.solver.ran = true;
-  f.solver.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  f.solver.termination = ceres::TerminationTypeToString(summary.termination_type);
-  f.solver.initial_cost = summary.initial_cost;
-  f.solver.final_cost = summary.final_cost;
-  const Eigen::Quaterniond q_sol(q_map(3), q_map(0), q_map(1), q_map(2));
-  const Eigen::Vector2d t_sol = t_map;
-  f.solver.usable = summary.IsSolutionUsable() && q_sol.coeffs().allFinite() &&
-                    t_sol.allFinite() && std::isfinite(summary.final_cost);
-  f.solver.time_ms = MsSince(t_solve);
-  if (f.solver.usable) {
-    R_v = q_sol.normalized();
-    t = t_sol;
+  f->solver.ran = true;
+  f->solver.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  f->solver.termination = ceres::TerminationTypeToString(summary.termination_type);
+  f->solver.initial_cost = summary.initial_cost;
+  f->solver.final_cost = summary.final_cost;
+  const Eigen::Quaterniond q_sol(pp->q_block[3], pp->q_block[0], pp->q_block[1],
+                                 pp->q_block[2]);
+  const Eigen::Vector2d t_sol = pp->t();
+  f->solver.usable = summary.IsSolutionUsable() && q_sol.coeffs().allFinite() &&
+                     t_sol.allFinite() && std::isfinite(summary.final_cost);
+  f->solver.time_ms = MsSince(t_solve);
+  if (f->solver.usable) {
+    *R_v = q_sol.normalized();
+    *t = t_sol;
   } else {
-    f.flags.solver_failed = true;
+    f->flags.solver_failed = true;
     ++stats_.solver_failures;
   }
-  f.timings.solve_ms = f.solver.time_ms;
+  f->timings.solve_ms = f->solver.time_ms;
+}
 
+void Stabilizer::ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v,
+                                Eigen::Vector2d* t, StabilizerFrame* f) {
   // Protrusion handling (§4.4): binary search towards the real pose, else
   // the previous warp.
   const auto t_prot = Clock::now();
-  ProtrusionReport check = protrusion_.Check(R_v, t, f.rows, 0.0);
+  const ProtrusionReport check = protrusion_.Check(*R_v, *t, f->rows, 0.0);
   if (!check.defined) {
-    f.flags.protrusion_search = true;
+    f->flags.protrusion_search = true;
     ++stats_.protrusion_searches;
+    const Eigen::Quaterniond R_sol = *R_v;
+    const Eigen::Vector2d t_sol = *t;
     auto pose_at = [&](double s, Eigen::Quaterniond* q, Eigen::Vector2d* tt) {
-      *q = R_v.slerp(s, f.R_r).normalized();
-      *tt = (1.0 - s) * t;
+      *q = R_sol.slerp(s, f->R_r).normalized();
+      *tt = (1.0 - s) * t_sol;
     };
     Eigen::Quaterniond q_real;
     Eigen::Vector2d t_real;
     pose_at(1.0, &q_real, &t_real);
-    if (protrusion_.Check(q_real, t_real, f.rows, 0.0).defined) {
+    if (protrusion_.Check(q_real, t_real, f->rows, 0.0).defined) {
       double lo = 0.0, hi = 1.0;  // lo: undefined, hi: defined
       for (int i = 0; i < options_.protrusion_search_steps; ++i) {
         const double mid = 0.5 * (lo + hi);
         Eigen::Quaterniond qm;
         Eigen::Vector2d tm;
         pose_at(mid, &qm, &tm);
-        (protrusion_.Check(qm, tm, f.rows, 0.0).defined ? hi : lo) = mid;
+        (protrusion_.Check(qm, tm, f->rows, 0.0).defined ? hi : lo) = mid;
       }
-      pose_at(hi, &R_v, &t);
-      f.flags.protrusion_search_s = hi;
+      pose_at(hi, R_v, t);
+      f->flags.protrusion_search_s = hi;
     } else {
       // Nothing valid between P_v and P_r: apply the previous warp, i.e. the
       // same real-to-virtual rotation as on the previous frame.
-      f.flags.previous_warp = true;
+      f->flags.previous_warp = true;
       ++stats_.previous_warp_fallbacks;
-      if (history_ > 0) {
-        R_v = AlignSign((R_v_prev_ * R_r_prev_.conjugate() * f.R_r).normalized(),
-                        R_v_prev_);
-        t = t_prev_;
+      if (layer.history > 0) {
+        *R_v = AlignSign((layer.R_v_prev * layer.R_r_prev.conjugate() * f->R_r).normalized(),
+                         layer.R_v_prev);
+        *t = layer.t_prev;
       } else {
-        R_v = f.R_r;
-        t.setZero();
+        *R_v = f->R_r;
+        t->setZero();
       }
-      f.flags.undefined_pixels =
-          !protrusion_.Check(R_v, t, f.rows, 0.0).defined;
+      f->flags.undefined_pixels = !protrusion_.Check(*R_v, *t, f->rows, 0.0).defined;
     }
   }
-  if (f.flags.undefined_pixels) ++stats_.undefined_frames;
-  f.timings.protrusion_ms = MsSince(t_prot);
+  if (f->flags.undefined_pixels) ++stats_.undefined_frames;
+  f->timings.protrusion_ms = MsSince(t_prot);
+}
 
+void Stabilizer::EnergiesStep(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+                              PoseProblem* pp, StabilizerFrame* f) const {
   // Energies at the final pose.
-  q_map = R_v.coeffs();
-  t_map = t;
-  f.energies.fit = TermEnergy(&problem, b_fit);
-  f.energies.distortion = TermEnergy(&problem, b_dist);
-  f.energies.follow = TermEnergy(&problem, b_follow);
-  f.energies.rotation = TermEnergy(&problem, b_rot);
-  f.energies.translation = TermEnergy(&problem, b_trans);
-  f.energies.protrusion = TermEnergy(&problem, b_prot);
+  pp->q() = R_v.coeffs();
+  pp->t() = t;
+  f->energies.fit = TermEnergy(&pp->problem, pp->b_fit);
+  f->energies.distortion = TermEnergy(&pp->problem, pp->b_dist);
+  f->energies.follow = TermEnergy(&pp->problem, pp->b_follow);
+  f->energies.rotation = TermEnergy(&pp->problem, pp->b_rot);
+  f->energies.translation = TermEnergy(&pp->problem, pp->b_trans);
+  f->energies.protrusion = TermEnergy(&pp->problem, pp->b_prot);
+}
 
-  f.R_v = R_v;
-  f.t = t;
-
+void Stabilizer::AdvanceStep(Time stamp, LayerState* layer, const StabilizerFrame& f) const {
   // Advance the trajectory.
-  R_v_prev_prev_ = history_ > 0 ? R_v_prev_ : R_v;
-  t_prev_prev_ = history_ > 0 ? t_prev_ : t;
-  R_v_prev_ = history_ > 0 ? AlignSign(R_v, R_v_prev_) : R_v;
-  t_prev_ = t;
-  R_r_prev_ = f.R_r;
-  last_stamp_ = stamp;
-  history_ = std::min(history_ + 1, 2);
+  const Eigen::Quaterniond& R_v = f.R_v;
+  const Eigen::Vector2d& t = f.t;
+  layer->R_v_prev_prev = layer->history > 0 ? layer->R_v_prev : R_v;
+  layer->t_prev_prev = layer->history > 0 ? layer->t_prev : t;
+  layer->R_v_prev = layer->history > 0 ? AlignSign(R_v, layer->R_v_prev) : R_v;
+  layer->t_prev = t;
+  layer->R_r_prev = f.R_r;
+  layer->last_stamp = stamp;
+  layer->history = std::min(layer->history + 1, 2);
   if (f.has_target) {
-    H_prev_ = f.H;
-    has_H_ = true;
+    layer->H_prev = f.H;
+    layer->has_H = true;
   } else {
-    has_H_ = false;
+    layer->has_H = false;
   }
-  ++stats_.frames;
-  if (use_face) ++stats_.frames_with_face;
-  f.timings.total_ms = MsSince(start);
-  *frame = std::move(f);
-  return Status::Ok();
 }
 
 }  // namespace steadiface

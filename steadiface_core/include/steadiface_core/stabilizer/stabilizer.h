@@ -141,11 +141,57 @@ class Stabilizer {
   Stabilizer(const CameraModel& model, const OutputGeometry& output,
              const StabilizerOptions& options);
 
-  // One Ceres solve from the initial pose; fills the report and energies.
-  bool Solve(const RowRotations& rows, const FaceObservation* face,
-             const Eigen::Vector2d& H, const StabilizerWeights& w,
-             Eigen::Quaterniond* R_v, Eigen::Vector2d* t,
-             SolverReport* report, TermEnergies* energies) const;
+  // The trajectory of one virtual camera (a layer): what the smoothness
+  // terms, the initial pose and the head target remember between frames.
+  struct LayerState {
+    int history = 0;  // frames since start/reset (capped at 2)
+    Time last_stamp;
+    Eigen::Quaterniond R_v_prev = Eigen::Quaterniond::Identity();
+    Eigen::Quaterniond R_v_prev_prev = Eigen::Quaterniond::Identity();
+    Eigen::Quaterniond R_r_prev = Eigen::Quaterniond::Identity();
+    Eigen::Vector2d t_prev = Eigen::Vector2d::Zero();
+    Eigen::Vector2d t_prev_prev = Eigen::Vector2d::Zero();
+    bool has_H = false;
+    Eigen::Vector2d H_prev = Eigen::Vector2d::Zero();
+  };
+  struct PoseProblem;  // one frame's Ceres problem (stabilizer.cc)
+
+  // Process(), step by step, in this order.
+  // Row rotations: validates the stamp, builds the per-row real rotations
+  // and R_r (middle row), and the time since the layer's previous frame.
+  Status RowRotationsStep(Time stamp, const OrientationTimeline& timeline,
+                          const RowTiming& timing, const LayerState& layer,
+                          StabilizerFrame* f, double* dt);
+  // Dynamic weights (§4.4); `face` is null unless usable.
+  StabilizerWeights DynamicWeightsStep(Time stamp, const OrientationTimeline& timeline,
+                                       const LayerState& layer, const FaceObservation* face,
+                                       double dt, StabilizerFrame* f);
+  // Initial pose (Eq. 12).
+  void InitialPoseStep(const LayerState& layer, const StabilizerFrame& f,
+                       Eigen::Quaterniond* R_v0, Eigen::Vector2d* t0) const;
+  // The face E_f fits: this frame's, or the held one while w_f fades out
+  // (then written to *held); null when none.
+  const FaceObservation* HeldFaceStep(const LayerState& layer, const FaceObservation* face,
+                                      const StabilizerWeights& w, FaceObservation* held,
+                                      StabilizerFrame* f);
+  // Head target H (Eq. 1), and the held face updated from a usable one.
+  void HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face, bool use_face,
+                      const StabilizerWeights& w, const Eigen::Quaterniond& R_v0,
+                      const Eigen::Vector2d& t0, StabilizerFrame* f);
+  // Solve (Eq. 5) from the initial pose in *R_v, *t; the solution replaces
+  // it when usable.
+  void SolveStep(Time stamp, const OrientationTimeline& timeline, const RowTiming& timing,
+                 const LayerState& layer, const FaceObservation* fit_face,
+                 const StabilizerWeights& w, double dt, PoseProblem* problem,
+                 Eigen::Quaterniond* R_v, Eigen::Vector2d* t, StabilizerFrame* f);
+  // Protrusion search towards the real pose, else the previous warp.
+  void ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v, Eigen::Vector2d* t,
+                      StabilizerFrame* f);
+  // Every term's energy at the final pose.
+  void EnergiesStep(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+                    PoseProblem* problem, StabilizerFrame* f) const;
+  // Advances the layer's trajectory to this frame (f.R_v, f.t set).
+  void AdvanceStep(Time stamp, LayerState* layer, const StabilizerFrame& f) const;
 
   const CameraModel model_;
   const OutputGeometry output_;
@@ -155,16 +201,8 @@ class Stabilizer {
   DynamicWeights dynamic_;
   StabilizerStats stats_;
 
-  // Trajectory state.
-  int history_ = 0;  // frames since start/reset (capped at 2)
-  Time last_stamp_;
-  Eigen::Quaterniond R_v_prev_ = Eigen::Quaterniond::Identity();
-  Eigen::Quaterniond R_v_prev_prev_ = Eigen::Quaterniond::Identity();
-  Eigen::Quaterniond R_r_prev_ = Eigen::Quaterniond::Identity();
-  Eigen::Vector2d t_prev_ = Eigen::Vector2d::Zero();
-  Eigen::Vector2d t_prev_prev_ = Eigen::Vector2d::Zero();
-  bool has_H_ = false;
-  Eigen::Vector2d H_prev_ = Eigen::Vector2d::Zero();
+  // The face-following layer's trajectory (the paper's one virtual camera).
+  LayerState subject_;
   // Real rotation of the epoch's first frame: the world-fixed reference
   // camera for the variation measure and the held face (so results do not
   // depend on where gyro integration started).
