@@ -25,6 +25,8 @@ Status ValidatePipelineOptions(const PipelineOptions& o) {
   }
   s = ValidateStabilizerOptions(o.stabilizer);
   if (!s.ok()) return s;
+  s = ValidateGyroVideoCheckOptions(o.gyro_video_check);
+  if (!s.ok()) return s;
   return ValidateWarpOptions(o.warp);
 }
 
@@ -56,6 +58,11 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
   if (!s.ok()) return s;
   s = Warper::Create(model, options.warp, &p->warper_);
   if (!s.ok()) return s;
+  if (options.gyro_video_check.enabled) {
+    s = GyroVideoCheck::Create(model.intrinsics(), p->timing_, options.imu.R_cam_imu.normalized(),
+                               options.gyro_video_check, &p->check_);
+    if (!s.ok()) return s;
+  }
   *out = std::move(p);
   return Status::Ok();
 }
@@ -101,6 +108,13 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     }
   }
   f.timings.face_ms = MsSince(t_face);
+  // The gyro-vs-video check (never changes the pose), outside the face.
+  if (check_ != nullptr) {
+    const auto t_check = std::chrono::steady_clock::now();
+    check_->Process(image, stamp, timeline_, f.face.valid ? f.face.box : cv::Rect2d());
+    f.gyro_video_check = check_->result();
+    f.timings.check_ms = MsSince(t_check);
+  }
   // Stabilizer.
   const auto t_stab = std::chrono::steady_clock::now();
   Status s = stabilizer_->Process(stamp, timeline_, timing_, obs, &f.stabilizer);
@@ -148,6 +162,7 @@ void Pipeline::Reset() {
   timeline_.reset();
   if (tracker_ != nullptr) tracker_->reset();
   stabilizer_->reset();
+  if (check_ != nullptr) check_->Reset();
 }
 
 }  // namespace steadiface

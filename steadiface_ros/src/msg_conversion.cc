@@ -376,6 +376,15 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   m.previous_warp = f.flags.previous_warp;
   m.undefined_pixels = f.flags.undefined_pixels;
   m.gyro_extrapolated = gyro_extrapolated;
+  const steadiface::GyroVideoCheckResult& c = pf.gyro_video_check;
+  m.check_judged = c.judged;
+  m.check_motion_px = c.motion_px;
+  m.check_residual_px = c.residual_configured_px;
+  m.check_best_mounting_residual_px = c.residual_best_mounting_px;
+  m.imu_rotation_contradicts = c.rotation_contradicts;
+  m.suggested_R_cam_imu = ToMsg(c.best_R_cam_imu);
+  m.imu_offset_correction_s = c.offset_correction_s;
+  m.imu_offset_off = c.offset_off;
   m.face_ms = pf.timings.face_ms;
   m.stabilizer_ms = pf.timings.stabilizer_ms;
   m.warp_ms = pf.timings.mesh_ms + pf.timings.maps_ms + pf.timings.remap_ms;

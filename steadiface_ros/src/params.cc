@@ -286,6 +286,20 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Int("warp/mesh_rows", &po->warp.mesh_rows, 1, 512);
   r.Int("warp/num_threads", &po->warp.num_threads, 0, 256);
   r.Bool("warp/fixed_point_maps", &po->warp.fixed_point_maps);
+  // The gyro-vs-video check.
+  GyroVideoCheckOptions& c = po->gyro_video_check;
+  r.Bool("gyro_video_check/enabled", &c.enabled);
+  r.Int("gyro_video_check/stride", &c.stride, 1, 100);
+  r.Int("gyro_video_check/track_width", &c.track_width, 64, 4096);
+  r.Int("gyro_video_check/max_features", &c.max_features, 8, 2000);
+  r.Num("gyro_video_check/max_fb_error", &c.max_fb_error_px, 1e-3, 10.0);
+  r.Num("gyro_video_check/window", &c.window_s, 0.5, 60.0);
+  r.Num("gyro_video_check/offset_range", &c.offset_range_s, 0.0, 0.5);
+  r.Num("gyro_video_check/offset_step", &c.offset_step_s, 0.0005, 0.1);
+  r.Int("gyro_video_check/min_pairs", &c.min_pairs, 2, 100000);
+  r.Num("gyro_video_check/min_motion", &c.min_motion_px, 0.0, 1000.0);
+  r.Num("gyro_video_check/better_mounting_ratio", &c.better_mounting_ratio, 0.01, 0.99);
+  r.Num("gyro_video_check/offset_warn", &c.offset_warn_s, 1e-4, 1.0);
   Status st = r.status();
   if (!st.ok()) return st;
   // Cross-field checks of the core (e.g. low < high) with its own messages.

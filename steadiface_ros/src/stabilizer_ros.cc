@@ -2,6 +2,7 @@
 
 
 #include <cmath>
+#include <cstdio>
 
 #include "steadiface_ros/msg_conversion.h"
 
@@ -83,6 +84,7 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   updater_->add("solver", this, &StabilizerRos::DiagSolver);
   updater_->add("frames", this, &StabilizerRos::DiagFrames);
   updater_->add("protrusion", this, &StabilizerRos::DiagProtrusion);
+  updater_->add("gyro vs video", this, &StabilizerRos::DiagGyroVideo);
 
   // 4. Subscribers: IMU never lazy, with a large queue.
   imu_sub_ = nh_.subscribe("imu", 2000, &StabilizerRos::OnImu, this,
@@ -350,6 +352,51 @@ void StabilizerRos::DiagProtrusion(diagnostic_updater::DiagnosticStatusWrapper& 
     s.summary(diagnostic_msgs::DiagnosticStatus::OK, "no protrusion fallback");
   }
   reported_fallbacks_ = f;
+}
+
+void StabilizerRos::DiagGyroVideo(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const WrapperStatus w = wrapper_->Status();
+  const steadiface::GyroVideoCheckResult& c = w.gyro_video_check;
+  const Eigen::Quaterniond& q = c.best_R_cam_imu;
+  char quat[96];
+  std::snprintf(quat, sizeof(quat), "[%.3f, %.3f, %.3f, %.3f]", q.x(), q.y(), q.z(), q.w());
+  s.add("judged", c.judged);
+  s.add("frame pairs in window", c.pairs);
+  s.add("feature motion per pair [px]", c.motion_px);
+  s.add("residual with imu/R_cam_imu [px]", c.residual_configured_px);
+  s.add("residual with the best axis permutation [px]", c.residual_best_mounting_px);
+  s.add("best axis permutation as imu/R_cam_imu [x y z w]", std::string(quat));
+  s.add("imu/time_offset correction [ms]", c.offset_correction_s * 1e3);
+  char text[400];
+  if (!pipeline_options_.gyro_video_check.enabled) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "check off (gyro_video_check/enabled)");
+  } else if (!c.judged) {
+    std::snprintf(text, sizeof(text),
+                  "not enough image motion yet to judge (%d frame pairs, %.1f px)", c.pairs,
+                  c.motion_px);
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, text);
+  } else if (c.rotation_contradicts) {
+    std::snprintf(text, sizeof(text),
+                  "imu/R_cam_imu contradicts the video: the gyro predicts the background's "
+                  "motion to %.1f px, the axis permutation %s to %.1f px (of %.1f px motion); "
+                  "set imu/R_cam_imu: %s",
+                  c.residual_configured_px, quat, c.residual_best_mounting_px, c.motion_px, quat);
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN, text);
+  } else if (c.offset_off) {
+    std::snprintf(text, sizeof(text),
+                  "imu/time_offset is off by %+.1f ms: the video agrees best with imu/time_offset "
+                  "%+.1f ms (%.4f s)",
+                  c.offset_correction_s * 1e3, c.offset_correction_s * 1e3,
+                  pipeline_options_.imu.imu_time_offset_s + c.offset_correction_s);
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN, text);
+  } else {
+    std::snprintf(text, sizeof(text),
+                  "gyro agrees with the video (residual %.2f px of %.1f px motion, offset within "
+                  "%.0f ms)",
+                  c.residual_configured_px, c.motion_px,
+                  pipeline_options_.gyro_video_check.offset_warn_s * 1e3);
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, text);
+  }
 }
 
 }  // namespace steadiface_ros

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "steadiface_core/calibration/gyro_video_check.h"
 #include "steadiface_core/camera_model.h"
 #include "steadiface_core/face/face_tracker.h"
 #include "steadiface_core/orientation_timeline.h"
@@ -41,12 +42,15 @@ struct PipelineOptions {
   WarpOptions warp;
   /// Produce the stabilized image (false: poses only, e.g. for scoring).
   bool render_output = true;
+  /// The live check of the gyro's configuration against the video.
+  GyroVideoCheckOptions gyro_video_check;
 };
 
 Status ValidatePipelineOptions(const PipelineOptions& options);
 
 struct PipelineTimings {
   double face_ms = 0.0;
+  double check_ms = 0.0;  ///< GyroVideoCheck
   double stabilizer_ms = 0.0;
   double mesh_ms = 0.0;
   double maps_ms = 0.0;
@@ -64,6 +68,8 @@ struct PipelineFrame {
   /// Intrinsics of `output` (virtual focal and principal offset).
   CameraIntrinsics output_intrinsics;
   PipelineTimings timings;
+  /// The gyro-vs-video check over its window (GyroVideoCheck).
+  GyroVideoCheckResult gyro_video_check;
 };
 
 /// The whole per-frame chain for one camera + IMU stream: gyro timeline,
@@ -120,6 +126,7 @@ class Pipeline {
   std::unique_ptr<FaceTracker> tracker_;
   std::unique_ptr<Stabilizer> stabilizer_;
   std::unique_ptr<Warper> warper_;
+  std::unique_ptr<GyroVideoCheck> check_;  // null when disabled
 };
 
 }  // namespace steadiface

@@ -82,6 +82,7 @@ class StabilizerRos : public OutputSink {
   void DiagSolver(diagnostic_updater::DiagnosticStatusWrapper& s);
   void DiagFrames(diagnostic_updater::DiagnosticStatusWrapper& s);
   void DiagProtrusion(diagnostic_updater::DiagnosticStatusWrapper& s);
+  void DiagGyroVideo(diagnostic_updater::DiagnosticStatusWrapper& s);
 
   ros::NodeHandle nh_, pnh_;
   std::string name_;

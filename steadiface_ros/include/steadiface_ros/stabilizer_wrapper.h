@@ -90,6 +90,8 @@ struct WrapperStatus {
   double last_solver_ms = 0.0;
   int last_solver_iterations = 0;
   std::string last_error;
+  /// The gyro-vs-video check as of the last frame.
+  steadiface::GyroVideoCheckResult gyro_video_check;
 };
 
 /// The one object behind the nodelet, the node and the offline bag tool: it

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <sstream>
 #include <vector>
@@ -150,6 +151,33 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
        << "}";
     truth_json = tj.str();
   }
+  // The gyro-vs-video check as of the last frame.
+  std::string check_json;
+  if (!sink.states.empty()) {
+    const auto& s = sink.states.back();
+    std::ostringstream cj;
+    cj << ",\n  \"gyro_video_check\": {\"judged\": " << (s.check_judged ? "true" : "false")
+       << ", \"motion_px\": " << s.check_motion_px
+       << ", \"residual_px\": " << s.check_residual_px
+       << ", \"best_mounting_residual_px\": " << s.check_best_mounting_residual_px
+       << ", \"imu_rotation_contradicts\": " << (s.imu_rotation_contradicts ? "true" : "false")
+       << ", \"suggested_R_cam_imu\": [" << s.suggested_R_cam_imu.x << ", "
+       << s.suggested_R_cam_imu.y << ", " << s.suggested_R_cam_imu.z << ", "
+       << s.suggested_R_cam_imu.w << "]"
+       << ", \"imu_offset_correction_s\": " << s.imu_offset_correction_s
+       << ", \"imu_offset_off\": " << (s.imu_offset_off ? "true" : "false") << "}";
+    check_json = cj.str();
+    if (s.imu_rotation_contradicts) {
+      std::cerr << "steadiface_bag: WARNING: imu/R_cam_imu contradicts the video (residual "
+                << s.check_residual_px << " px; the axis permutation [" << s.suggested_R_cam_imu.x
+                << ", " << s.suggested_R_cam_imu.y << ", " << s.suggested_R_cam_imu.z << ", "
+                << s.suggested_R_cam_imu.w << "] explains it to " << s.check_best_mounting_residual_px
+                << " px): set imu/R_cam_imu\n";
+    } else if (s.imu_offset_off) {
+      std::cerr << "steadiface_bag: WARNING: imu/time_offset is off by "
+                << s.imu_offset_correction_s * 1e3 << " ms (add it to imu/time_offset)\n";
+    }
+  }
   std::ostringstream rep;
   rep.precision(6);
   rep << "{\n  \"input\": \"" << r.in << "\",\n  \"frames_in\": " << ws.counters.images_in
@@ -179,7 +207,7 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       << "\"solver\": [" << Percentile(solver_ms, 0.5) << ", " << Percentile(solver_ms, 0.99) << "], "
       << "\"warp\": [" << Percentile(warp_ms, 0.5) << ", " << Percentile(warp_ms, 0.99) << "], "
       << "\"total\": [" << Percentile(total_ms, 0.5) << ", " << Percentile(total_ms, 0.99) << "]}"
-      << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5) << truth_json
+      << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5) << check_json << truth_json
       << ",\n  \"method\": \"" << (r.gyro_only ? "gyro-only" : "steadiface") << "\"\n}\n";
   return rep.str();
 }
