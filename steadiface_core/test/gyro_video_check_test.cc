@@ -24,7 +24,8 @@ struct CheckRun {
 // `R_imu_cam` and stamped `clock_offset_s` early; the timeline is built with
 // `configured_R_cam_imu` and no offset, as a misconfigured node would.
 CheckRun Feed(const Eigen::Quaterniond& R_imu_cam, double clock_offset_s,
-         const Eigen::Quaterniond& configured_R_cam_imu, double seconds = 4.0) {
+              const Eigen::Quaterniond& configured_R_cam_imu,
+              double seconds = 4.0) {
   sim::SimulatorOptions o;
   EXPECT_TRUE(sim::ApplyPreset("walk", &o).ok());
   o.data_dir = STEADIFACE_TEST_DATA_DIR;
@@ -42,7 +43,8 @@ CheckRun Feed(const Eigen::Quaterniond& R_imu_cam, double clock_offset_s,
   rs.readout_time_s = o.readout_s;
   const RowTiming timing(rs, o.height);
   std::unique_ptr<GyroVideoCheck> check;
-  EXPECT_TRUE(GyroVideoCheck::Create(sim->intrinsics(), timing, configured_R_cam_imu,
+  EXPECT_TRUE(GyroVideoCheck::Create(sim->intrinsics(), timing,
+                                     configured_R_cam_imu,
                                      GyroVideoCheckOptions(), &check)
                   .ok());
   CheckRun run;
@@ -53,23 +55,27 @@ CheckRun Feed(const Eigen::Quaterniond& R_imu_cam, double clock_offset_s,
     sim->Render(i, &frame, &truth);
     // The gyro up to this frame's last row (as a live node waits for it).
     while (g < sim->imu().size() &&
-           sim->imu()[g].stamp <= timing.LastRowTime(truth.stamp) + FromSeconds(0.08)) {
+           sim->imu()[g].stamp <=
+               timing.LastRowTime(truth.stamp) + FromSeconds(0.08)) {
       GyroSample s = sim->imu()[g++];
       s.angular_velocity = R_imu_cam * s.angular_velocity;
       timeline.AddSample(s);
     }
     check->Process(frame, truth.stamp, timeline, cv::Rect2d());
-    if (run.frames_to_contradiction < 0 && check->result().rotation_contradicts) {
+    if (run.frames_to_contradiction < 0 &&
+        check->result().rotation_contradicts) {
       run.frames_to_contradiction = i;
     }
   }
   run.result = check->result();
   const GyroVideoCheckResult& q = run.result;
-  std::cout << "  pairs " << q.pairs << ", motion " << q.motion_px << " px, residual configured "
-            << q.residual_configured_px << " px, best mounting " << q.residual_best_mounting_px
-            << " px, contradicts " << q.rotation_contradicts << " (first at frame "
-            << run.frames_to_contradiction << "), offset correction "
-            << q.offset_correction_s * 1e3 << " ms\n";
+  std::cout << "  pairs " << q.pairs << ", motion " << q.motion_px
+            << " px, residual configured " << q.residual_configured_px
+            << " px, best mounting " << q.residual_best_mounting_px
+            << " px, contradicts " << q.rotation_contradicts
+            << " (first at frame " << run.frames_to_contradiction
+            << "), offset correction " << q.offset_correction_s * 1e3
+            << " ms\n";
   return run;
 }
 
@@ -77,7 +83,8 @@ double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
   return Eigen::AngleAxisd(a * b.conjugate()).angle() * 180.0 / M_PI;
 }
 
-TEST(GyroVideoCheckTest, TheTwentyFourSignedPermutationsAreDistinctProperRotations) {
+TEST(GyroVideoCheckTest,
+     TheTwentyFourSignedPermutationsAreDistinctProperRotations) {
   const auto& all = GyroVideoCheck::SignedAxisPermutations();
   ASSERT_EQ(all.size(), 24u);
   for (size_t i = 0; i < all.size(); ++i) {
@@ -87,21 +94,26 @@ TEST(GyroVideoCheckTest, TheTwentyFourSignedPermutationsAreDistinctProperRotatio
 }
 
 TEST(GyroVideoCheckTest, RightConfigurationStaysQuiet) {
-  const CheckRun r = Feed(Eigen::Quaterniond::Identity(), 0.0, Eigen::Quaterniond::Identity());
-  ASSERT_TRUE(r.result.judged) << "pairs " << r.result.pairs << ", motion " << r.result.motion_px;
+  const CheckRun r =
+      Feed(Eigen::Quaterniond::Identity(), 0.0, Eigen::Quaterniond::Identity());
+  ASSERT_TRUE(r.result.judged)
+      << "pairs " << r.result.pairs << ", motion " << r.result.motion_px;
   EXPECT_FALSE(r.result.rotation_contradicts)
       << "configured " << r.result.residual_configured_px << " px, best "
       << r.result.residual_best_mounting_px << " px";
   EXPECT_FALSE(r.result.offset_off) << r.result.offset_correction_s;
   EXPECT_LT(std::abs(r.result.offset_correction_s), 0.003);
-  EXPECT_LT(AngleDeg(r.result.best_R_cam_imu, Eigen::Quaterniond::Identity()), 1.0);
+  EXPECT_LT(AngleDeg(r.result.best_R_cam_imu, Eigen::Quaterniond::Identity()),
+            1.0);
   // The gyro explains the motion: well below the features' own motion.
   EXPECT_LT(r.result.residual_configured_px, 0.3 * r.result.motion_px);
 }
 
-TEST(GyroVideoCheckTest, APermutedImuLeftAtIdentityIsFlaggedWithTheRightMountingWithinSeconds) {
+TEST(GyroVideoCheckTest,
+     APermutedImuLeftAtIdentityIsFlaggedWithTheRightMountingWithinSeconds) {
   // A phone-style mounting: x and y swapped, z flipped.
-  const Eigen::Matrix3d M = (Eigen::Matrix3d() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
+  const Eigen::Matrix3d M =
+      (Eigen::Matrix3d() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
   const Eigen::Quaterniond R_imu_cam(M);
   const CheckRun r = Feed(R_imu_cam, 0.0, Eigen::Quaterniond::Identity());
   ASSERT_TRUE(r.result.judged);
@@ -111,11 +123,13 @@ TEST(GyroVideoCheckTest, APermutedImuLeftAtIdentityIsFlaggedWithTheRightMounting
   // The mounting to configure: R_cam_imu = R_imu_cam^-1.
   EXPECT_LT(AngleDeg(r.result.best_R_cam_imu, R_imu_cam.conjugate()), 1.0);
   ASSERT_GE(r.frames_to_contradiction, 0);
-  EXPECT_LT(r.frames_to_contradiction, 30 * 3) << "flagged only at frame " << r.frames_to_contradiction;
+  EXPECT_LT(r.frames_to_contradiction, 30 * 3)
+      << "flagged only at frame " << r.frames_to_contradiction;
 }
 
 TEST(GyroVideoCheckTest, AThirtyMillisecondClockOffsetIsEstimated) {
-  const CheckRun r = Feed(Eigen::Quaterniond::Identity(), 0.030, Eigen::Quaterniond::Identity());
+  const CheckRun r = Feed(Eigen::Quaterniond::Identity(), 0.030,
+                          Eigen::Quaterniond::Identity());
   ASSERT_TRUE(r.result.judged);
   EXPECT_FALSE(r.result.rotation_contradicts);
   EXPECT_TRUE(r.result.offset_off);

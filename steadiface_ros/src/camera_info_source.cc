@@ -17,42 +17,50 @@ Status ResolveCameraInfoUrl(const std::string& url, std::string* path) {
     const std::string rest = url.substr(package.size());
     const size_t slash = rest.find('/');
     if (slash == std::string::npos || slash == 0 || slash + 1 == rest.size()) {
-      return Status::Error("camera_info_url '" + url + "': expected package://PACKAGE/PATH");
+      return Status::Error("camera_info_url '" + url +
+                           "': expected package://PACKAGE/PATH");
     }
     const std::string pkg = rest.substr(0, slash);
     const std::string dir = ros::package::getPath(pkg);
     if (dir.empty()) {
-      return Status::Error("camera_info_url '" + url + "': package '" + pkg + "' not found");
+      return Status::Error("camera_info_url '" + url + "': package '" + pkg +
+                           "' not found");
     }
     *path = dir + rest.substr(slash);
   } else if (url.find("://") != std::string::npos) {
-    return Status::Error("camera_info_url '" + url +
-                         "': unsupported scheme (use file://, package:// or a path)");
+    return Status::Error(
+        "camera_info_url '" + url +
+        "': unsupported scheme (use file://, package:// or a path)");
   } else {
     *path = url;
   }
-  if (path->empty()) return Status::Error("camera_info_url '" + url + "': empty path");
+  if (path->empty())
+    return Status::Error("camera_info_url '" + url + "': empty path");
   return Status::Ok();
 }
 
-Status LoadCameraInfoUrl(const std::string& url, sensor_msgs::CameraInfo* info) {
+Status LoadCameraInfoUrl(const std::string& url,
+                         sensor_msgs::CameraInfo* info) {
   std::string path;
   Status s = ResolveCameraInfoUrl(url, &path);
   if (!s.ok()) return s;
   if (!std::ifstream(path).good()) {
-    return Status::Error("camera_info_url '" + url + "': cannot read '" + path + "'");
+    return Status::Error("camera_info_url '" + url + "': cannot read '" + path +
+                         "'");
   }
   std::string camera_name;
   sensor_msgs::CameraInfo ci;
   if (!camera_calibration_parsers::readCalibration(path, camera_name, ci)) {
-    return Status::Error("camera_info_url '" + url + "': '" + path +
-                         "' is not a camera calibration file (YAML or INI as written by "
-                         "camera_calibration)");
+    return Status::Error(
+        "camera_info_url '" + url + "': '" + path +
+        "' is not a camera calibration file (YAML or INI as written by "
+        "camera_calibration)");
   }
   if (ci.width == 0 || ci.height == 0 || ci.K[0] <= 0.0 || ci.K[4] <= 0.0) {
-    return Status::Error("camera_info_url '" + url +
-                         "': the file needs image_width, image_height and a camera_matrix "
-                         "with positive fx, fy");
+    return Status::Error(
+        "camera_info_url '" + url +
+        "': the file needs image_width, image_height and a camera_matrix "
+        "with positive fx, fy");
   }
   *info = ci;
   return Status::Ok();
@@ -68,7 +76,8 @@ Status CameraInfoSource::Load(const std::string& url) {
 }
 
 sensor_msgs::CameraInfoConstPtr CameraInfoSource::Select(
-    const sensor_msgs::Image& image, const sensor_msgs::CameraInfoConstPtr& from_message) {
+    const sensor_msgs::Image& image,
+    const sensor_msgs::CameraInfoConstPtr& from_message) {
   if (from_message) {
     Report(Choice::kMessage, image);
     return from_message;
@@ -90,18 +99,24 @@ void CameraInfoSource::Report(Choice c, const sensor_msgs::Image& image) {
   if (!log_) return;
   switch (c) {
     case Choice::kMessage:
-      log_(false, has_file_ ? "intrinsics from the camera_info messages (they win over "
-                              "camera_info_url " + url_ + ")"
-                            : "intrinsics from the camera_info messages");
+      log_(false,
+           has_file_
+               ? "intrinsics from the camera_info messages (they win over "
+                 "camera_info_url " +
+                     url_ + ")"
+               : "intrinsics from the camera_info messages");
       break;
     case Choice::kFile:
-      log_(false, "intrinsics from camera_info_url " + url_ + " (no camera_info message)");
+      log_(false, "intrinsics from camera_info_url " + url_ +
+                      " (no camera_info message)");
       break;
     case Choice::kSizeMismatch:
-      log_(true, "camera_info_url " + url_ + " is for " + std::to_string(file_info_.width) +
-                     "x" + std::to_string(file_info_.height) + " images, but the images are " +
-                     std::to_string(image.width) + "x" + std::to_string(image.height) +
-                     ": frames dropped");
+      log_(true, "camera_info_url " + url_ + " is for " +
+                     std::to_string(file_info_.width) + "x" +
+                     std::to_string(file_info_.height) +
+                     " images, but the images are " +
+                     std::to_string(image.width) + "x" +
+                     std::to_string(image.height) + ": frames dropped");
       break;
     case Choice::kNone:
       break;

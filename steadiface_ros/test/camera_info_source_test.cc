@@ -55,18 +55,22 @@ TEST(CameraInfoUrlTest, ResolvesFilePackageAndPlainPaths) {
   ASSERT_TRUE(ResolveCameraInfoUrl("relative/b.ini", &p).ok());
   EXPECT_EQ(p, "relative/b.ini");
   // package:// needs ROS_PACKAGE_PATH; the catkin test environment has it.
-  const steadiface::Status s =
-      ResolveCameraInfoUrl("package://steadiface/config/examples/euroc_cam0_calibration.yaml", &p);
+  const steadiface::Status s = ResolveCameraInfoUrl(
+      "package://steadiface/config/examples/euroc_cam0_calibration.yaml", &p);
   ASSERT_TRUE(s.ok()) << s.message();
   EXPECT_TRUE(std::ifstream(p).good()) << p;
-  EXPECT_NE(p.find("config/examples/euroc_cam0_calibration.yaml"), std::string::npos);
+  EXPECT_NE(p.find("config/examples/euroc_cam0_calibration.yaml"),
+            std::string::npos);
 
-  steadiface::Status bad = ResolveCameraInfoUrl("http://example.org/cam.yaml", &p);
+  steadiface::Status bad =
+      ResolveCameraInfoUrl("http://example.org/cam.yaml", &p);
   EXPECT_FALSE(bad.ok());
-  EXPECT_NE(bad.message().find("unsupported scheme"), std::string::npos) << bad.message();
+  EXPECT_NE(bad.message().find("unsupported scheme"), std::string::npos)
+      << bad.message();
   bad = ResolveCameraInfoUrl("package://no_such_package_xyz/cam.yaml", &p);
   EXPECT_FALSE(bad.ok());
-  EXPECT_NE(bad.message().find("no_such_package_xyz"), std::string::npos) << bad.message();
+  EXPECT_NE(bad.message().find("no_such_package_xyz"), std::string::npos)
+      << bad.message();
   EXPECT_FALSE(ResolveCameraInfoUrl("package://steadiface", &p).ok());
 }
 
@@ -74,15 +78,19 @@ TEST(CameraInfoUrlTest, ReadsYamlAndIniAsCameraCalibrationWritesThem) {
   const sensor_msgs::CameraInfo truth = SomeInfo(640, 480);
   for (const std::string ext : {"yaml", "ini"}) {
     const std::string path = TempPath("cam." + ext);
-    ASSERT_TRUE(camera_calibration_parsers::writeCalibration(path, "cam", truth)) << ext;
+    ASSERT_TRUE(
+        camera_calibration_parsers::writeCalibration(path, "cam", truth))
+        << ext;
     sensor_msgs::CameraInfo got;
     const steadiface::Status s = LoadCameraInfoUrl("file://" + path, &got);
     ASSERT_TRUE(s.ok()) << ext << ": " << s.message();
     EXPECT_EQ(got.width, 640u);
     EXPECT_EQ(got.height, 480u);
-    for (int i = 0; i < 9; ++i) EXPECT_NEAR(got.K[i], truth.K[i], 1e-9) << ext << " K" << i;
+    for (int i = 0; i < 9; ++i)
+      EXPECT_NEAR(got.K[i], truth.K[i], 1e-9) << ext << " K" << i;
     ASSERT_EQ(got.D.size(), truth.D.size()) << ext;
-    for (size_t i = 0; i < truth.D.size(); ++i) EXPECT_NEAR(got.D[i], truth.D[i], 1e-9);
+    for (size_t i = 0; i < truth.D.size(); ++i)
+      EXPECT_NEAR(got.D[i], truth.D[i], 1e-9);
     // And the core accepts it as it accepts a camera_info message.
     steadiface::CameraIntrinsics k;
     ASSERT_TRUE(ToCameraIntrinsics(got, &k).ok());
@@ -94,9 +102,11 @@ TEST(CameraInfoUrlTest, ReadsYamlAndIniAsCameraCalibrationWritesThem) {
 
 TEST(CameraInfoUrlTest, RefusesMissingAndMalformedFilesNamingThem) {
   sensor_msgs::CameraInfo ci;
-  steadiface::Status s = LoadCameraInfoUrl("file:///nonexistent/dir/cam.yaml", &ci);
+  steadiface::Status s =
+      LoadCameraInfoUrl("file:///nonexistent/dir/cam.yaml", &ci);
   EXPECT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("/nonexistent/dir/cam.yaml"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("/nonexistent/dir/cam.yaml"), std::string::npos)
+      << s.message();
 
   const std::string garbage = TempPath("garbage.yaml");
   std::ofstream(garbage) << "this: [is, not, a calibration\n";
@@ -108,7 +118,8 @@ TEST(CameraInfoUrlTest, RefusesMissingAndMalformedFilesNamingThem) {
   const std::string empty_k = TempPath("empty_k.yaml");
   sensor_msgs::CameraInfo zero = SomeInfo(640, 480);
   zero.K = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-  ASSERT_TRUE(camera_calibration_parsers::writeCalibration(empty_k, "cam", zero));
+  ASSERT_TRUE(
+      camera_calibration_parsers::writeCalibration(empty_k, "cam", zero));
   s = LoadCameraInfoUrl(empty_k, &ci);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("fx"), std::string::npos) << s.message();
@@ -118,7 +129,8 @@ TEST(CameraInfoUrlTest, RefusesMissingAndMalformedFilesNamingThem) {
 
 TEST(CameraInfoSourceTest, AMessageWinsTheFileFillsInAndTheChoiceIsLoggedOnce) {
   const std::string path = TempPath("src.yaml");
-  ASSERT_TRUE(camera_calibration_parsers::writeCalibration(path, "cam", SomeInfo(64, 48)));
+  ASSERT_TRUE(camera_calibration_parsers::writeCalibration(path, "cam",
+                                                           SomeInfo(64, 48)));
   std::vector<std::string> log;
   int errors = 0;
   CameraInfoSource src([&](bool is_error, const std::string& t) {
@@ -150,7 +162,8 @@ TEST(CameraInfoSourceTest, AMessageWinsTheFileFillsInAndTheChoiceIsLoggedOnce) {
   EXPECT_NE(log[1].find("win"), std::string::npos) << log[1];
 
   // The file's size does not match the images: refused, one error.
-  for (int i = 0; i < 3; ++i) EXPECT_FALSE(src.Select(Image(80, 48, 300.0 + i), nullptr));
+  for (int i = 0; i < 3; ++i)
+    EXPECT_FALSE(src.Select(Image(80, 48, 300.0 + i), nullptr));
   EXPECT_EQ(errors, 1);
   EXPECT_NE(log.back().find("64x48"), std::string::npos) << log.back();
   std::remove(path.c_str());
@@ -161,7 +174,8 @@ TEST(CameraInfoSourceTest, WithoutAUrlOnlyMessagesGiveIntrinsics) {
   ASSERT_TRUE(src.Load("").ok());
   EXPECT_FALSE(src.has_file_info());
   EXPECT_FALSE(src.Select(Image(64, 48, 1.0), nullptr));
-  sensor_msgs::CameraInfoConstPtr msg(new sensor_msgs::CameraInfo(SomeInfo(64, 48)));
+  sensor_msgs::CameraInfoConstPtr msg(
+      new sensor_msgs::CameraInfo(SomeInfo(64, 48)));
   EXPECT_EQ(src.Select(Image(64, 48, 1.0), msg), msg);
 }
 
@@ -174,8 +188,8 @@ struct Loaded {
 Loaded LoadExample(const std::string& name) {
   std::unique_ptr<ParamSource> p;
   Loaded l;
-  const steadiface::Status s =
-      YamlParams({kConfigDir + "/default.yaml", kConfigDir + "/examples/" + name}, &p);
+  const steadiface::Status s = YamlParams(
+      {kConfigDir + "/default.yaml", kConfigDir + "/examples/" + name}, &p);
   EXPECT_TRUE(s.ok()) << name << ": " << s.message();
   if (!s.ok()) return l;
   const steadiface::Status ls = LoadOptions(*p, &l.po, &l.wo);
@@ -183,15 +197,17 @@ Loaded LoadExample(const std::string& name) {
   return l;
 }
 
-TEST(ExampleOverlaysTest, EurocCam0IsGlobalShutterMonoWithARotatedImuAndIntrinsicsFromAFile) {
+TEST(ExampleOverlaysTest,
+     EurocCam0IsGlobalShutterMonoWithARotatedImuAndIntrinsicsFromAFile) {
   const Loaded l = LoadExample("euroc_cam0.yaml");
   EXPECT_EQ(l.po.shutter.readout_time_s, 0.0);
   EXPECT_FALSE(l.wo.imu_extrinsics_from_tf);
   // R_cam_imu is the inverse of the rotation block of EuRoC's T_BS.
-  const Eigen::Matrix3d R_BS = (Eigen::Matrix3d() << 0.0148655429818, -0.999880929698,
-                                0.00414029679422, 0.999557249008, 0.0149672133247,
-                                0.025715529948, -0.0257744366974, 0.00375618835797,
-                                0.999660727178).finished();
+  const Eigen::Matrix3d R_BS =
+      (Eigen::Matrix3d() << 0.0148655429818, -0.999880929698, 0.00414029679422,
+       0.999557249008, 0.0149672133247, 0.025715529948, -0.0257744366974,
+       0.00375618835797, 0.999660727178)
+          .finished();
   const Eigen::Matrix3d R = l.po.imu.R_cam_imu.toRotationMatrix();
   EXPECT_LT((R - R_BS.transpose()).norm(), 1e-6) << R;
   // The IMU's x axis is (about) the camera's -y: a quarter turn, not identity.
@@ -213,11 +229,13 @@ TEST(ExampleOverlaysTest, EurocCam0IsGlobalShutterMonoWithARotatedImuAndIntrinsi
   EXPECT_EQ(k.distortion, steadiface::DistortionModel::kPlumbBob);
 }
 
-TEST(ExampleOverlaysTest, RealsenseD435iTakesTheGyroMountingFromTfWithARollingShutter) {
+TEST(ExampleOverlaysTest,
+     RealsenseD435iTakesTheGyroMountingFromTfWithARollingShutter) {
   const Loaded l = LoadExample("realsense_d435i.yaml");
   EXPECT_TRUE(l.wo.imu_extrinsics_from_tf);
   EXPECT_GT(l.po.shutter.readout_time_s, 0.005);
-  EXPECT_TRUE(l.wo.camera_info_url.empty());  // the driver publishes camera_info
+  EXPECT_TRUE(
+      l.wo.camera_info_url.empty());  // the driver publishes camera_info
 }
 
 TEST(ExampleOverlaysTest, PhoneFrontCameraIsAHalfTurnAboutTheOpticalAxis) {

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sensor_msgs/image_encodings.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sensor_msgs/image_encodings.h>
 
 #include "steadiface_ros/msg_conversion.h"
 
@@ -35,7 +35,8 @@ cv::Mat Picture(int w = 64, int h = 48) {
   return bgr;
 }
 
-sensor_msgs::Image Message(const std::string& encoding, int w, int h, int bytes_per_px) {
+sensor_msgs::Image Message(const std::string& encoding, int w, int h,
+                           int bytes_per_px) {
   sensor_msgs::Image m;
   m.encoding = encoding;
   m.width = w;
@@ -64,7 +65,8 @@ void ToYuv(const cv::Vec3b& p, double* y, double* u, double* v) {
   *v = 128 + 0.439 * r - 0.368 * g - 0.071 * b;
 }
 
-sensor_msgs::Image Yuv422(const cv::Mat& bgr, bool uyvy, const std::string& encoding) {
+sensor_msgs::Image Yuv422(const cv::Mat& bgr, bool uyvy,
+                          const std::string& encoding) {
   sensor_msgs::Image m = Message(encoding, bgr.cols, bgr.rows, 2);
   for (int y = 0; y < bgr.rows; ++y) {
     for (int x = 0; x < bgr.cols; x += 2) {
@@ -72,11 +74,15 @@ sensor_msgs::Image Yuv422(const cv::Mat& bgr, bool uyvy, const std::string& enco
       ToYuv(bgr.at<cv::Vec3b>(y, x), &y0, &u0, &v0);
       ToYuv(bgr.at<cv::Vec3b>(y, x + 1), &y1, &u1, &v1);
       uint8_t* q = &m.data[y * m.step + 2 * x];
-      auto c = [](double v) { return cv::saturate_cast<uint8_t>(std::lround(v)); };
+      auto c = [](double v) {
+        return cv::saturate_cast<uint8_t>(std::lround(v));
+      };
       if (uyvy) {
-        q[0] = c((u0 + u1) / 2), q[1] = c(y0), q[2] = c((v0 + v1) / 2), q[3] = c(y1);
+        q[0] = c((u0 + u1) / 2), q[1] = c(y0), q[2] = c((v0 + v1) / 2),
+        q[3] = c(y1);
       } else {
-        q[0] = c(y0), q[1] = c((u0 + u1) / 2), q[2] = c(y1), q[3] = c((v0 + v1) / 2);
+        q[0] = c(y0), q[1] = c((u0 + u1) / 2), q[2] = c(y1),
+        q[3] = c((v0 + v1) / 2);
       }
     }
   }
@@ -109,11 +115,15 @@ TEST(ImageFormatsTest, EveryBayerPatternDemosaicsToTheRightColours) {
   const cv::Mat truth = Picture();
   // The channel (b=0, g=1, r=2) at each site of the top-left 2x2.
   const std::vector<std::pair<std::string, std::array<int, 4>>> patterns = {
-      {"rggb", {2, 1, 1, 0}}, {"bggr", {0, 1, 1, 2}}, {"gbrg", {1, 0, 2, 1}}, {"grbg", {1, 2, 0, 1}}};
+      {"rggb", {2, 1, 1, 0}},
+      {"bggr", {0, 1, 1, 2}},
+      {"gbrg", {1, 0, 2, 1}},
+      {"grbg", {1, 2, 0, 1}}};
   for (const auto& [name, sites] : patterns) {
     for (int depth : {8, 16}) {
       const std::string encoding = "bayer_" + name + std::to_string(depth);
-      sensor_msgs::Image m = Message(encoding, truth.cols, truth.rows, depth / 8);
+      sensor_msgs::Image m =
+          Message(encoding, truth.cols, truth.rows, depth / 8);
       for (int y = 0; y < truth.rows; ++y) {
         for (int x = 0; x < truth.cols; ++x) {
           const int ch = sites[(y % 2) * 2 + (x % 2)];
@@ -121,7 +131,8 @@ TEST(ImageFormatsTest, EveryBayerPatternDemosaicsToTheRightColours) {
           if (depth == 8) {
             m.data[y * m.step + x] = v;
           } else {
-            const uint16_t v16 = static_cast<uint16_t>(v * 257);  // full 16-bit range
+            const uint16_t v16 =
+                static_cast<uint16_t>(v * 257);  // full 16-bit range
             std::memcpy(&m.data[y * m.step + 2 * x], &v16, 2);
           }
         }
@@ -169,7 +180,8 @@ TEST(ImageFormatsTest, DepthAndUnknownImagesAreRefusedNamingTheEncoding) {
   }
 }
 
-sensor_msgs::CompressedImage Compressed(const cv::Mat& img, const std::string& ext,
+sensor_msgs::CompressedImage Compressed(const cv::Mat& img,
+                                        const std::string& ext,
                                         const std::string& format) {
   sensor_msgs::CompressedImage c;
   c.header.stamp.fromSec(12.5);
@@ -190,12 +202,14 @@ TEST(ImageFormatsTest, CompressedJpegAndPngAsImageTransportPublishesThem) {
     std::string ext, format, encoding;
     double tol;
   };
-  for (const Case& c : std::vector<Case>{{truth, ".png", "bgr8; png compressed bgr8", enc::BGR8, 0},
-                                         {truth, ".jpg", "bgr8; jpeg compressed bgr8", enc::BGR8, 12},
-                                         {grey, ".png", "mono8; png compressed mono8", enc::MONO8, 0},
-                                         {grey, ".jpg", "jpeg", enc::MONO8, 8}}) {
+  for (const Case& c : std::vector<Case>{
+           {truth, ".png", "bgr8; png compressed bgr8", enc::BGR8, 0},
+           {truth, ".jpg", "bgr8; jpeg compressed bgr8", enc::BGR8, 12},
+           {grey, ".png", "mono8; png compressed mono8", enc::MONO8, 0},
+           {grey, ".jpg", "jpeg", enc::MONO8, 8}}) {
     sensor_msgs::ImagePtr msg;
-    const steadiface::Status s = FromCompressedImage(Compressed(c.img, c.ext, c.format), &msg);
+    const steadiface::Status s =
+        FromCompressedImage(Compressed(c.img, c.ext, c.format), &msg);
     ASSERT_TRUE(s.ok()) << c.format << ": " << s.message();
     EXPECT_EQ(msg->encoding, c.encoding) << c.format;
     EXPECT_EQ(msg->header.frame_id, "cam");
@@ -209,8 +223,10 @@ TEST(ImageFormatsTest, CompressedJpegAndPngAsImageTransportPublishesThem) {
   broken.data.resize(20);
   steadiface::Status s = FromCompressedImage(broken, &msg);
   EXPECT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("cannot decode"), std::string::npos) << s.message();
-  s = FromCompressedImage(Compressed(truth, ".png", "16UC1; compressedDepth png"), &msg);
+  EXPECT_NE(s.message().find("cannot decode"), std::string::npos)
+      << s.message();
+  s = FromCompressedImage(
+      Compressed(truth, ".png", "16UC1; compressedDepth png"), &msg);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("depth"), std::string::npos) << s.message();
   broken.data.clear();

@@ -28,7 +28,8 @@ Status ValidateGyroVideoCheckOptions(const GyroVideoCheckOptions& o) {
     return Status::Error("gyro_video_check/stride must be in [1, 100]");
   }
   if (!(o.track_width >= 64 && o.track_width <= 4096)) {
-    return Status::Error("gyro_video_check/track_width must be in [64, 4096] px");
+    return Status::Error(
+        "gyro_video_check/track_width must be in [64, 4096] px");
   }
   if (!(o.max_features >= 8 && o.max_features <= 2000)) {
     return Status::Error("gyro_video_check/max_features must be in [8, 2000]");
@@ -42,22 +43,26 @@ Status ValidateGyroVideoCheckOptions(const GyroVideoCheckOptions& o) {
   if (!(o.offset_range_s >= 0.0 && o.offset_range_s <= 0.5) ||
       !(o.offset_step_s >= 0.0005 && o.offset_step_s <= 0.1)) {
     return Status::Error(
-        "gyro_video_check/offset_range must be in [0, 0.5] s and offset_step in [0.0005, 0.1] s");
+        "gyro_video_check/offset_range must be in [0, 0.5] s and offset_step "
+        "in [0.0005, 0.1] s");
   }
   if (!(o.min_pairs >= 2) || !(o.min_motion_px >= 0.0) ||
       !(o.better_mounting_ratio > 0.0 && o.better_mounting_ratio < 1.0) ||
       !(o.offset_warn_s > 0.0)) {
     return Status::Error(
-        "gyro_video_check: min_pairs >= 2, min_motion >= 0, better_mounting_ratio in (0, 1), "
+        "gyro_video_check: min_pairs >= 2, min_motion >= 0, "
+        "better_mounting_ratio in (0, 1), "
         "offset_warn > 0");
   }
   return Status::Ok();
 }
 
-const std::vector<Eigen::Quaterniond>& GyroVideoCheck::SignedAxisPermutations() {
+const std::vector<Eigen::Quaterniond>&
+GyroVideoCheck::SignedAxisPermutations() {
   static const std::vector<Eigen::Quaterniond> all = [] {
     std::vector<Eigen::Quaterniond> v;
-    const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                             {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
     for (const auto& p : perms) {
       for (int signs = 0; signs < 8; ++signs) {
         Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
@@ -70,7 +75,8 @@ const std::vector<Eigen::Quaterniond>& GyroVideoCheck::SignedAxisPermutations() 
   return all;
 }
 
-Status GyroVideoCheck::Create(const CameraIntrinsics& intrinsics, const RowTiming& timing,
+Status GyroVideoCheck::Create(const CameraIntrinsics& intrinsics,
+                              const RowTiming& timing,
                               const Eigen::Quaterniond& R_cam_imu,
                               const GyroVideoCheckOptions& options,
                               std::unique_ptr<GyroVideoCheck>* out) {
@@ -78,19 +84,26 @@ Status GyroVideoCheck::Create(const CameraIntrinsics& intrinsics, const RowTimin
   if (!s.ok()) return s;
   s = ValidateGyroVideoCheckOptions(options);
   if (!s.ok()) return s;
-  if (!R_cam_imu.coeffs().allFinite() || std::abs(R_cam_imu.norm() - 1.0) > 1e-6) {
-    return Status::Error("gyro_video_check: R_cam_imu must be a unit quaternion");
+  if (!R_cam_imu.coeffs().allFinite() ||
+      std::abs(R_cam_imu.norm() - 1.0) > 1e-6) {
+    return Status::Error(
+        "gyro_video_check: R_cam_imu must be a unit quaternion");
   }
   out->reset(new GyroVideoCheck(intrinsics, timing, R_cam_imu, options));
   return Status::Ok();
 }
 
-GyroVideoCheck::GyroVideoCheck(const CameraIntrinsics& intrinsics, const RowTiming& timing,
+GyroVideoCheck::GyroVideoCheck(const CameraIntrinsics& intrinsics,
+                               const RowTiming& timing,
                                const Eigen::Quaterniond& R_cam_imu,
                                const GyroVideoCheckOptions& options)
-    : k_(intrinsics), timing_(timing), R_cam_imu_(R_cam_imu.normalized()), options_(options) {
+    : k_(intrinsics),
+      timing_(timing),
+      R_cam_imu_(R_cam_imu.normalized()),
+      options_(options) {
   scale_ = std::min(1.0, static_cast<double>(options.track_width) / k_.width);
-  const int n = static_cast<int>(std::floor(options.offset_range_s / options.offset_step_s + 1e-9));
+  const int n = static_cast<int>(
+      std::floor(options.offset_range_s / options.offset_step_s + 1e-9));
   for (int i = -n; i <= n; ++i) offsets_.push_back(i * options.offset_step_s);
 }
 
@@ -103,9 +116,11 @@ void GyroVideoCheck::Reset() {
   result_ = GyroVideoCheckResult();
 }
 
-void GyroVideoCheck::Process(const cv::Mat& image, Time stamp, const OrientationTimeline& timeline,
+void GyroVideoCheck::Process(const cv::Mat& image, Time stamp,
+                             const OrientationTimeline& timeline,
                              const cv::Rect2d& face_box) {
-  if (!options_.enabled || image.empty() || image.cols != k_.width || image.rows != k_.height) {
+  if (!options_.enabled || image.empty() || image.cols != k_.width ||
+      image.rows != k_.height) {
     return;
   }
   if (has_prev_ && stamp <= prev_stamp_) Reset();
@@ -124,7 +139,9 @@ void GyroVideoCheck::Process(const cv::Mat& image, Time stamp, const Orientation
   if (image.channels() == 1) {
     grey = image;
   } else {
-    cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+    cv::cvtColor(
+        image, grey,
+        image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
   }
   if (scale_ < 1.0) {
     cv::resize(grey, grey, cv::Size(), scale_, scale_, cv::INTER_LINEAR);
@@ -136,30 +153,37 @@ void GyroVideoCheck::Process(const cv::Mat& image, Time stamp, const Orientation
     // Features in the previous frame, outside the (enlarged) face.
     cv::Mat mask(prev_grey_.size(), CV_8UC1, cv::Scalar(255));
     if (face_box.width > 0 && face_box.height > 0) {
-      const cv::Rect2d r(face_box.x - 0.3 * face_box.width, face_box.y - 0.3 * face_box.height,
+      const cv::Rect2d r(face_box.x - 0.3 * face_box.width,
+                         face_box.y - 0.3 * face_box.height,
                          1.6 * face_box.width, 1.6 * face_box.height);
-      cv::rectangle(mask,
-                    cv::Rect(cvRound(r.x * scale_), cvRound(r.y * scale_),
-                             cvRound(r.width * scale_), cvRound(r.height * scale_)),
-                    cv::Scalar(0), cv::FILLED);
+      cv::rectangle(
+          mask,
+          cv::Rect(cvRound(r.x * scale_), cvRound(r.y * scale_),
+                   cvRound(r.width * scale_), cvRound(r.height * scale_)),
+          cv::Scalar(0), cv::FILLED);
     }
     std::vector<cv::Point2f> a, b, back;
-    cv::goodFeaturesToTrack(prev_grey_, a, options_.max_features, 0.01, 8.0, mask);
+    cv::goodFeaturesToTrack(prev_grey_, a, options_.max_features, 0.01, 8.0,
+                            mask);
     Pending p;
     p.a = prev_stamp_;
     p.b = stamp;
     if (a.size() >= 8) {
       std::vector<uchar> st1, st2;
       std::vector<float> e1, e2;
-      cv::calcOpticalFlowPyrLK(prev_grey_, grey, a, b, st1, e1, cv::Size(11, 11), 2);
-      cv::calcOpticalFlowPyrLK(grey, prev_grey_, b, back, st2, e2, cv::Size(11, 11), 2);
+      cv::calcOpticalFlowPyrLK(prev_grey_, grey, a, b, st1, e1,
+                               cv::Size(11, 11), 2);
+      cv::calcOpticalFlowPyrLK(grey, prev_grey_, b, back, st2, e2,
+                               cv::Size(11, 11), 2);
       for (size_t i = 0; i < a.size(); ++i) {
         if (!st1[i] || !st2[i]) continue;
         const double fb = std::hypot(back[i].x - a[i].x, back[i].y - a[i].y);
         if (!(fb <= options_.max_fb_error_px)) continue;
         Eigen::Vector2d pa, pb;
-        if (!UndistortPixel(k_, Eigen::Vector2d(a[i].x, a[i].y) / scale_, &pa) ||
-            !UndistortPixel(k_, Eigen::Vector2d(b[i].x, b[i].y) / scale_, &pb)) {
+        if (!UndistortPixel(k_, Eigen::Vector2d(a[i].x, a[i].y) / scale_,
+                            &pa) ||
+            !UndistortPixel(k_, Eigen::Vector2d(b[i].x, b[i].y) / scale_,
+                            &pb)) {
           continue;
         }
         p.ya.push_back(a[i].y / scale_);
@@ -190,18 +214,21 @@ void GyroVideoCheck::EvaluateReady(const OrientationTimeline& timeline) {
   if (added) Judge();
 }
 
-void GyroVideoCheck::Evaluate(const Pending& p, const OrientationTimeline& timeline) {
+void GyroVideoCheck::Evaluate(const Pending& p,
+                              const OrientationTimeline& timeline) {
   const Duration range = FromSeconds(options_.offset_range_s);
   if (!timeline.Covers(timing_.FirstRowTime(p.a) - range)) return;
   // Rotations at each row band's centre, per offset hypothesis.
   auto band = [&](double y) {
-    return std::min(kBands - 1, std::max(0, static_cast<int>(y * kBands / k_.height)));
+    return std::min(kBands - 1,
+                    std::max(0, static_cast<int>(y * kBands / k_.height)));
   };
-  auto rotations = [&](Time stamp, double offset, std::array<Eigen::Quaterniond, kBands>* R) {
+  auto rotations = [&](Time stamp, double offset,
+                       std::array<Eigen::Quaterniond, kBands>* R) {
     for (int i = 0; i < kBands; ++i) {
       const double yc = (i + 0.5) * k_.height / kBands;
-      if (!QuerySucceeded(timeline.RealRotation(timing_.RowTime(stamp, yc) + FromSeconds(offset),
-                                                &(*R)[i]))) {
+      if (!QuerySucceeded(timeline.RealRotation(
+              timing_.RowTime(stamp, yc) + FromSeconds(offset), &(*R)[i]))) {
         return false;
       }
     }
@@ -211,22 +238,26 @@ void GyroVideoCheck::Evaluate(const Pending& p, const OrientationTimeline& timel
   rec.stamp = p.b;
   std::vector<double> r;
   r.reserve(p.xa.size());
-  for (size_t i = 0; i < p.xa.size(); ++i) r.push_back((p.xb[i] - p.xa[i]).norm());
+  for (size_t i = 0; i < p.xa.size(); ++i)
+    r.push_back((p.xb[i] - p.xa[i]).norm());
   rec.motion_px = Median(&r);
   auto residual = [&](const std::array<Eigen::Quaterniond, kBands>& Ra,
                       const std::array<Eigen::Quaterniond, kBands>& Rb,
                       const Eigen::Quaterniond* C) {
     r.clear();
     for (size_t i = 0; i < p.xa.size(); ++i) {
-      Eigen::Quaterniond rel = Rb[band(p.yb[i])] * Ra[band(p.ya[i])].conjugate();
+      Eigen::Quaterniond rel =
+          Rb[band(p.yb[i])] * Ra[band(p.ya[i])].conjugate();
       if (C != nullptr) rel = *C * rel * C->conjugate();
-      const Eigen::Vector3d ray((p.xa[i].x() - k_.cx) / k_.fx, (p.xa[i].y() - k_.cy) / k_.fy, 1.0);
+      const Eigen::Vector3d ray((p.xa[i].x() - k_.cx) / k_.fx,
+                                (p.xa[i].y() - k_.cy) / k_.fy, 1.0);
       const Eigen::Vector3d q = rel * ray;
       if (!(q.z() > 1e-6)) {
         r.push_back(1e3);
         continue;
       }
-      const Eigen::Vector2d pred(k_.fx * q.x() / q.z() + k_.cx, k_.fy * q.y() / q.z() + k_.cy);
+      const Eigen::Vector2d pred(k_.fx * q.x() / q.z() + k_.cx,
+                                 k_.fy * q.y() / q.z() + k_.cy);
       r.push_back((pred - p.xb[i]).norm());
     }
     return Median(&r);
@@ -246,7 +277,8 @@ void GyroVideoCheck::Evaluate(const Pending& p, const OrientationTimeline& timel
 
 void GyroVideoCheck::Judge() {
   const Time newest = window_.empty() ? Time() : window_.back().stamp;
-  while (!window_.empty() && window_.front().stamp < newest - FromSeconds(options_.window_s)) {
+  while (!window_.empty() &&
+         window_.front().stamp < newest - FromSeconds(options_.window_s)) {
     window_.pop_front();
   }
   GyroVideoCheckResult res;
@@ -260,26 +292,30 @@ void GyroVideoCheck::Judge() {
   for (const PairRecord& p : window_) {
     res.motion_px += p.motion_px;
     for (size_t i = 0; i < off.size(); ++i) off[i] += p.offset_residual[i];
-    for (size_t i = 0; i < mount.size(); ++i) mount[i] += p.mounting_residual[i];
+    for (size_t i = 0; i < mount.size(); ++i)
+      mount[i] += p.mounting_residual[i];
   }
   const double n = static_cast<double>(window_.size());
   res.motion_px /= n;
   const size_t zero = offsets_.size() / 2;  // the configured offset
   res.residual_configured_px = off[zero] / n;
-  const size_t best_m = std::min_element(mount.begin(), mount.end()) - mount.begin();
+  const size_t best_m =
+      std::min_element(mount.begin(), mount.end()) - mount.begin();
   res.residual_best_mounting_px = mount[best_m] / n;
   res.best_R_cam_imu = SignedAxisPermutations()[best_m];
-  res.judged = res.pairs >= options_.min_pairs && res.motion_px >= options_.min_motion_px;
-  res.rotation_contradicts =
-      res.judged &&
-      res.residual_best_mounting_px < options_.better_mounting_ratio * res.residual_configured_px;
+  res.judged = res.pairs >= options_.min_pairs &&
+               res.motion_px >= options_.min_motion_px;
+  res.rotation_contradicts = res.judged && res.residual_best_mounting_px <
+                                               options_.better_mounting_ratio *
+                                                   res.residual_configured_px;
   // Offset: the best hypothesis, refined by a parabola through its
   // neighbours; the correction to add to imu/time_offset is its negative.
   const size_t b = std::min_element(off.begin(), off.end()) - off.begin();
   double delta = offsets_[b];
   if (b > 0 && b + 1 < off.size()) {
     const double denom = off[b - 1] - 2.0 * off[b] + off[b + 1];
-    if (denom > 1e-12) delta += 0.5 * options_.offset_step_s * (off[b - 1] - off[b + 1]) / denom;
+    if (denom > 1e-12)
+      delta += 0.5 * options_.offset_step_s * (off[b - 1] - off[b + 1]) / denom;
   }
   res.offset_correction_s = -delta;
   res.offset_off = res.judged && !res.rotation_contradicts &&

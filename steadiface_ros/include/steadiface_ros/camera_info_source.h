@@ -13,12 +13,14 @@ namespace steadiface_ros {
 /// `camera_info_url` -> a file path: "file:///abs/path", "package://pkg/rel"
 /// (ros::package), or a plain path. Anything else is an error naming the
 /// URL.
-steadiface::Status ResolveCameraInfoUrl(const std::string& url, std::string* path);
+steadiface::Status ResolveCameraInfoUrl(const std::string& url,
+                                        std::string* path);
 
 /// Loads a calibration file as ROS camera drivers write it
 /// (camera_calibration_parsers: the YAML of camera_calibration, or INI),
 /// through ResolveCameraInfoUrl. Rejects a file without fx, fy or a size.
-steadiface::Status LoadCameraInfoUrl(const std::string& url, sensor_msgs::CameraInfo* info);
+steadiface::Status LoadCameraInfoUrl(const std::string& url,
+                                     sensor_msgs::CameraInfo* info);
 
 /// Chooses the intrinsics of each image: a camera_info message when there
 /// is one (it wins), else the `camera_info_url` file's, stamped and framed
@@ -37,8 +39,9 @@ class CameraInfoSource {
   /// The camera_info for `image`: `from_message` if set, else the file's.
   /// Null when there is neither, or when the file's size differs from the
   /// image's (reported as an error, throttled to once per change).
-  sensor_msgs::CameraInfoConstPtr Select(const sensor_msgs::Image& image,
-                                         const sensor_msgs::CameraInfoConstPtr& from_message);
+  sensor_msgs::CameraInfoConstPtr Select(
+      const sensor_msgs::Image& image,
+      const sensor_msgs::CameraInfoConstPtr& from_message);
 
  private:
   enum class Choice { kNone, kMessage, kFile, kSizeMismatch };

@@ -2,9 +2,9 @@
 
 #include <deque>
 
-#include <Eigen/Geometry>
 #include <std_msgs/Header.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <Eigen/Geometry>
 
 #include "steadiface_core/camera_intrinsics.h"
 
@@ -27,14 +27,16 @@ class FrustaMarkers {
   /// Records this frame's orientations in the trails (call every frame, so
   /// the trails are full when a viewer subscribes). Non-finite ones are
   /// skipped.
-  void Add(const Eigen::Quaterniond& world_from_real, const Eigen::Quaterniond& world_from_virtual);
+  void Add(const Eigen::Quaterniond& world_from_real,
+           const Eigen::Quaterniond& world_from_virtual);
   /// Forgets the trails (time jumped back).
   void Clear();
   /// The marker array for the latest Add(); empty if there is none or an
   /// intrinsics is invalid.
-  visualization_msgs::MarkerArray Make(const std_msgs::Header& world_header,
-                                       const steadiface::CameraIntrinsics& real,
-                                       const steadiface::CameraIntrinsics& virtual_camera) const;
+  visualization_msgs::MarkerArray Make(
+      const std_msgs::Header& world_header,
+      const steadiface::CameraIntrinsics& real,
+      const steadiface::CameraIntrinsics& virtual_camera) const;
 
   size_t trail_size() const { return real_trail_.size(); }
 

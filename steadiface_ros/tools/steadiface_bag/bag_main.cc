@@ -41,32 +41,45 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Args {
-  std::string in, out, video, report, trajectory, truth, plot_dir, plot_name = "bag";
+  std::string in, out, video, report, trajectory, truth, plot_dir,
+      plot_name = "bag";
   std::vector<std::string> params;
   steadiface_bag::BagTopics topics;
   std::string compress = "none";
-  bool debug_overlay = false, debug_images_in_bag = false, gyro_only = false, quiet = false;
+  bool debug_overlay = false, debug_images_in_bag = false, gyro_only = false,
+       quiet = false;
   double start_stamp = 0.0;  // images before this stamp are skipped
-  std::string only_stamps;   // file of image stamps [s] to process; others skipped
+  std::string
+      only_stamps;  // file of image stamps [s] to process; others skipped
 };
 
 int Usage() {
   std::cerr
-      << "usage: steadiface_bag --in IN.bag [--out OUT.bag] [--params P.yaml]...\n"
+      << "usage: steadiface_bag --in IN.bag [--out OUT.bag] [--params "
+         "P.yaml]...\n"
          "  [--image TOPIC] [--info TOPIC] [--imu TOPIC] [--landmarks TOPIC]\n"
-         "  [--compress none|lz4|bz2: chunk compression of OUT.bag (default none)]\n"
-         "  [--debug-images-in-bag: also write the debug overlay images into OUT.bag]\n"
+         "  [--compress none|lz4|bz2: chunk compression of OUT.bag (default "
+         "none)]\n"
+         "  [--debug-images-in-bag: also write the debug overlay images into "
+         "OUT.bag]\n"
          "  [--video OUT.mp4] [--debug-overlay] [--report OUT.json]\n"
          "  [--trajectory OUT.csv] [--gyro-only] [--quiet]\n"
          "  [--truth IN.bag.truth.csv (default: found beside the bag)]\n"
-         "  [--plots DIR --name NAME: trajectories for scripts/plot_report.py]\n"
-         "  [--start-stamp S: skip images stamped before S (IMU is still read)]\n"
-         "  [--only-stamps FILE: process only the images whose stamps [s] are listed,\n"
+         "  [--plots DIR --name NAME: trajectories for "
+         "scripts/plot_report.py]\n"
+         "  [--start-stamp S: skip images stamped before S (IMU is still "
+         "read)]\n"
+         "  [--only-stamps FILE: process only the images whose stamps [s] are "
+         "listed,\n"
          "   one per line (to replay exactly the frames a live run received)]\n"
-         "The image topic may hold sensor_msgs/CompressedImage (jpeg/png, e.g.\n"
-         "--image camera/image_raw/compressed); it is decoded on the reader thread.\n"
-         "Intrinsics come from the bag's camera_info topic or, when the bag has none,\n"
-         "from the camera_info_url parameter (file://, package:// or a path to a\n"
+         "The image topic may hold sensor_msgs/CompressedImage (jpeg/png, "
+         "e.g.\n"
+         "--image camera/image_raw/compressed); it is decoded on the reader "
+         "thread.\n"
+         "Intrinsics come from the bag's camera_info topic or, when the bag "
+         "has none,\n"
+         "from the camera_info_url parameter (file://, package:// or a path to "
+         "a\n"
          "camera_calibration YAML/INI) in a --params file.\n";
   return 2;
 }
@@ -78,34 +91,56 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string s = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (s == "--in") a.in = next();
-    else if (s == "--out") a.out = next();
-    else if (s == "--params") a.params.push_back(next());
-    else if (s == "--image") a.topics.image = next();
-    else if (s == "--info") a.topics.info = next();
-    else if (s == "--imu") a.topics.imu = next();
-    else if (s == "--landmarks") a.topics.landmarks = next();
-    else if (s == "--compress") a.compress = next();
-    else if (s == "--debug-images-in-bag") a.debug_images_in_bag = true;
-    else if (s == "--video") a.video = next();
-    else if (s == "--debug-overlay") a.debug_overlay = true;
-    else if (s == "--report") a.report = next();
-    else if (s == "--trajectory") a.trajectory = next();
-    else if (s == "--gyro-only") a.gyro_only = true;
-    else if (s == "--quiet") a.quiet = true;
-    else if (s == "--truth") a.truth = next();
-    else if (s == "--start-stamp") a.start_stamp = std::atof(next().c_str());
-    else if (s == "--only-stamps") a.only_stamps = next();
-    else if (s == "--plots") a.plot_dir = next();
-    else if (s == "--name") a.plot_name = next();
+    if (s == "--in")
+      a.in = next();
+    else if (s == "--out")
+      a.out = next();
+    else if (s == "--params")
+      a.params.push_back(next());
+    else if (s == "--image")
+      a.topics.image = next();
+    else if (s == "--info")
+      a.topics.info = next();
+    else if (s == "--imu")
+      a.topics.imu = next();
+    else if (s == "--landmarks")
+      a.topics.landmarks = next();
+    else if (s == "--compress")
+      a.compress = next();
+    else if (s == "--debug-images-in-bag")
+      a.debug_images_in_bag = true;
+    else if (s == "--video")
+      a.video = next();
+    else if (s == "--debug-overlay")
+      a.debug_overlay = true;
+    else if (s == "--report")
+      a.report = next();
+    else if (s == "--trajectory")
+      a.trajectory = next();
+    else if (s == "--gyro-only")
+      a.gyro_only = true;
+    else if (s == "--quiet")
+      a.quiet = true;
+    else if (s == "--truth")
+      a.truth = next();
+    else if (s == "--start-stamp")
+      a.start_stamp = std::atof(next().c_str());
+    else if (s == "--only-stamps")
+      a.only_stamps = next();
+    else if (s == "--plots")
+      a.plot_dir = next();
+    else if (s == "--name")
+      a.plot_name = next();
     else if (s == "--help" || s == "-h") {
       Usage();
       return 0;
-    } else return Usage();
+    } else
+      return Usage();
   }
   if (a.in.empty()) return Usage();
   if (a.compress != "none" && a.compress != "lz4" && a.compress != "bz2") {
-    std::cerr << "steadiface_bag: --compress takes none, lz4 or bz2, not '" << a.compress << "'\n";
+    std::cerr << "steadiface_bag: --compress takes none, lz4 or bz2, not '"
+              << a.compress << "'\n";
     return 2;
   }
   // Parameters: the package defaults, then the user's files.
@@ -126,10 +161,13 @@ int main(int argc, char** argv) {
     po.stabilizer.gyro_only = true;
     po.landmark_source = steadiface::LandmarkSource::kNone;
   }
-  if (!a.topics.landmarks.empty()) po.landmark_source = steadiface::LandmarkSource::kExternal;
-  steadiface_ros::CameraInfoSource info_source([&a](bool is_error, const std::string& text) {
-    if (is_error || !a.quiet) std::cerr << "steadiface_bag: " << text << "\n";
-  });
+  if (!a.topics.landmarks.empty())
+    po.landmark_source = steadiface::LandmarkSource::kExternal;
+  steadiface_ros::CameraInfoSource info_source(
+      [&a](bool is_error, const std::string& text) {
+        if (is_error || !a.quiet)
+          std::cerr << "steadiface_bag: " << text << "\n";
+      });
   st = info_source.Load(wo.camera_info_url);
   if (!st.ok()) {
     std::cerr << "steadiface_bag: " << st.message() << "\n";
@@ -146,7 +184,8 @@ int main(int argc, char** argv) {
 
   // Writer stage.
   steadiface_bag::BagSink sink;
-  sink.debug = (a.debug_overlay && !a.video.empty()) || (a.debug_images_in_bag && !a.out.empty());
+  sink.debug = (a.debug_overlay && !a.video.empty()) ||
+               (a.debug_images_in_bag && !a.out.empty());
   sink.debug_to_bag = a.debug_images_in_bag;
   {
     std::string img = steadiface_bag::NormalizeTopic(a.topics.image);
@@ -157,18 +196,21 @@ int main(int argc, char** argv) {
       img.resize(img.size() - suffix.size());
     }
     const size_t slash = img.rfind('/');
-    sink.ns = slash == 0 || slash == std::string::npos ? "" : img.substr(0, slash);
+    sink.ns =
+        slash == 0 || slash == std::string::npos ? "" : img.substr(0, slash);
   }
   rosbag::Bag out;
   const std::string out_tmp = a.out + ".part";
   if (!a.out.empty()) {
     try {
       out.open(out_tmp, rosbag::bagmode::Write);
-      out.setCompression(a.compress == "lz4"   ? rosbag::compression::LZ4
-                         : a.compress == "bz2" ? rosbag::compression::BZ2
-                                               : rosbag::compression::Uncompressed);
+      out.setCompression(a.compress == "lz4" ? rosbag::compression::LZ4
+                         : a.compress == "bz2"
+                             ? rosbag::compression::BZ2
+                             : rosbag::compression::Uncompressed);
     } catch (const rosbag::BagException& e) {
-      std::cerr << "steadiface_bag: cannot write '" << out_tmp << "': " << e.what() << "\n";
+      std::cerr << "steadiface_bag: cannot write '" << out_tmp
+                << "': " << e.what() << "\n";
       return 1;
     }
   }
@@ -196,8 +238,10 @@ int main(int argc, char** argv) {
     }
   }
   steadiface_ros::StabilizerWrapper wrapper(po, wo, &sink);
-  steadiface_bag::BagStabilizer stabilizer(&wrapper, &info_source, reader.has_info(), selection);
-  stabilizer.set_on_image([&video](const sensor_msgs::Image& img) { video.AddInput(img); });
+  steadiface_bag::BagStabilizer stabilizer(&wrapper, &info_source,
+                                           reader.has_info(), selection);
+  stabilizer.set_on_image(
+      [&video](const sensor_msgs::Image& img) { video.AddInput(img); });
 
   const size_t total_images = reader.ImageCount();
   const bool tty = isatty(STDERR_FILENO) && !a.quiet;
@@ -212,22 +256,28 @@ int main(int argc, char** argv) {
     const size_t done = sink.states.size();
     if (done != state_written && (tty || done % 100 == 0)) {
       state_written = done;
-      const double el = std::chrono::duration<double>(Clock::now() - start).count();
+      const double el =
+          std::chrono::duration<double>(Clock::now() - start).count();
       const double fps = done / std::max(el, 1e-9);
-      const double eta = total_images > done ? (total_images - done) / std::max(fps, 1e-9) : 0.0;
+      const double eta = total_images > done
+                             ? (total_images - done) / std::max(fps, 1e-9)
+                             : 0.0;
       if (tty) {
         fprintf(stderr, "\r[%-30s] %zu/%zu frames  %.1f fps  ETA %.0f s ",
-                std::string(30 * done / std::max<size_t>(1, total_images), '#').c_str(), done,
-                total_images, fps, eta);
+                std::string(30 * done / std::max<size_t>(1, total_images), '#')
+                    .c_str(),
+                done, total_images, fps, eta);
       } else if (!a.quiet) {
-        fprintf(stderr, "steadiface_bag: %zu/%zu frames, %.1f fps, ETA %.0f s\n", done,
+        fprintf(stderr,
+                "steadiface_bag: %zu/%zu frames, %.1f fps, ETA %.0f s\n", done,
                 total_images, fps, eta);
       }
     }
   }
   const std::string read_error = reader.Join();
   if (!read_error.empty()) {
-    std::cerr << "steadiface_bag: reading " << a.in << " failed: " << read_error << "\n";
+    std::cerr << "steadiface_bag: reading " << a.in << " failed: " << read_error
+              << "\n";
     if (writer) writer->Finish();
     if (!a.out.empty()) std::remove(out_tmp.c_str());
     return 1;
@@ -243,13 +293,15 @@ int main(int argc, char** argv) {
   if (writer) {
     const std::string err = writer->Finish();
     if (!err.empty()) {
-      std::cerr << "steadiface_bag: writing " << out_tmp << " failed: " << err << "\n";
+      std::cerr << "steadiface_bag: writing " << out_tmp << " failed: " << err
+                << "\n";
       std::remove(out_tmp.c_str());
       return 1;
     }
   }
   video.Finish();
-  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  const double elapsed =
+      std::chrono::duration<double>(Clock::now() - start).count();
   if (!a.out.empty()) {
     out.close();
     if (std::rename(out_tmp.c_str(), a.out.c_str()) != 0) {
@@ -264,7 +316,8 @@ int main(int argc, char** argv) {
   steadiface_bag::ReportInputs r;
   r.in = a.in;
   r.truth = a.truth;
-  if (r.truth.empty() && std::ifstream(a.in + ".truth.csv").good()) r.truth = a.in + ".truth.csv";
+  if (r.truth.empty() && std::ifstream(a.in + ".truth.csv").good())
+    r.truth = a.in + ".truth.csv";
   r.plot_dir = a.plot_dir;
   r.plot_name = a.plot_name;
   r.gyro_only = a.gyro_only;
@@ -279,10 +332,12 @@ int main(int argc, char** argv) {
     f.close();
     std::rename((a.report + ".part").c_str(), a.report.c_str());
   }
-  if (!a.trajectory.empty()) steadiface_bag::WriteTrajectory(a.trajectory, sink);
+  if (!a.trajectory.empty())
+    steadiface_bag::WriteTrajectory(a.trajectory, sink);
   if (!a.quiet) {
-    std::cerr << "steadiface_bag: " << ws.counters.frames_out << " frames in " << elapsed
-              << " s (" << ws.counters.frames_out / std::max(elapsed, 1e-9) << " fps)"
+    std::cerr << "steadiface_bag: " << ws.counters.frames_out << " frames in "
+              << elapsed << " s ("
+              << ws.counters.frames_out / std::max(elapsed, 1e-9) << " fps)"
               << (a.out.empty() ? "" : ", wrote " + a.out)
               << (a.video.empty() ? "" : ", " + a.video)
               << (a.report.empty() ? "" : ", " + a.report) << "\n";

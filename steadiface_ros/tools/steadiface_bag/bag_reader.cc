@@ -38,23 +38,28 @@ steadiface::Status BagReader::Open(bool info_required) {
     auto it = types.find(NormalizeTopic(w.first));
     if (it == types.end()) {
       const bool is_info = w.second == "sensor_msgs/CameraInfo";
-      if (is_info && !info_required) continue;  // intrinsics from camera_info_url
-      std::cerr << "steadiface_bag: topic '" << NormalizeTopic(w.first) << "' (" << w.second
-                << ") is not in " << path_ << "; topics there:";
-      for (const auto& t : types) std::cerr << " " << t.first << " [" << t.second << "]";
+      if (is_info && !info_required)
+        continue;  // intrinsics from camera_info_url
+      std::cerr << "steadiface_bag: topic '" << NormalizeTopic(w.first) << "' ("
+                << w.second << ") is not in " << path_ << "; topics there:";
+      for (const auto& t : types)
+        std::cerr << " " << t.first << " [" << t.second << "]";
       std::cerr << "\n";
       if (is_info) {
         return Status::Error(
-            "no camera_info: name its topic with --info, or give the intrinsics with a "
+            "no camera_info: name its topic with --info, or give the "
+            "intrinsics with a "
             "camera_info_url in a --params file");
       }
       if (w.second != "sensor_msgs/Imu") return Status::Error("no image topic");
-      std::cerr << "steadiface_bag: continuing without IMU: frames pass through unstabilized\n";
-    } else if (w.second == "sensor_msgs/Image" && it->second == "sensor_msgs/CompressedImage") {
+      std::cerr << "steadiface_bag: continuing without IMU: frames pass "
+                   "through unstabilized\n";
+    } else if (w.second == "sensor_msgs/Image" &&
+               it->second == "sensor_msgs/CompressedImage") {
       compressed_ = true;
     } else if (it->second != w.second) {
-      return Status::Error("topic '" + NormalizeTopic(w.first) + "' has type " + it->second +
-                           ", expected " + w.second);
+      return Status::Error("topic '" + NormalizeTopic(w.first) + "' has type " +
+                           it->second + ", expected " + w.second);
     } else if (w.second == "sensor_msgs/CameraInfo") {
       has_info_ = true;
     }
@@ -62,24 +67,29 @@ steadiface::Status BagReader::Open(bool info_required) {
   return Status::Ok();
 }
 
-std::vector<std::string> BagReader::WithAndWithoutSlash(const std::string& t) const {
+std::vector<std::string> BagReader::WithAndWithoutSlash(
+    const std::string& t) const {
   std::vector<std::string> v = {NormalizeTopic(t)};
   if (NormalizeTopic(t).size() > 1) v.push_back(NormalizeTopic(t).substr(1));
   return v;
 }
 
 size_t BagReader::ImageCount() const {
-  return rosbag::View(bag_, rosbag::TopicQuery(WithAndWithoutSlash(topics_.image))).size();
+  return rosbag::View(bag_,
+                      rosbag::TopicQuery(WithAndWithoutSlash(topics_.image)))
+      .size();
 }
 
 void BagReader::Start(BoundedQueue<BagItem>* queue) {
   thread_ = std::thread([this, queue] {
     std::vector<std::string> topics;
-    for (const std::string& t : {topics_.image, topics_.info, topics_.imu, topics_.landmarks}) {
+    for (const std::string& t :
+         {topics_.image, topics_.info, topics_.imu, topics_.landmarks}) {
       if (t.empty()) continue;
       for (const auto& v : WithAndWithoutSlash(t)) topics.push_back(v);
     }
-    const std::string imu = NormalizeTopic(topics_.imu), info = NormalizeTopic(topics_.info),
+    const std::string imu = NormalizeTopic(topics_.imu),
+                      info = NormalizeTopic(topics_.info),
                       landmarks = NormalizeTopic(topics_.landmarks),
                       image = NormalizeTopic(topics_.image);
     try {
@@ -97,15 +107,18 @@ void BagReader::Start(BoundedQueue<BagItem>* queue) {
         } else if (topic == image && !compressed_) {
           item.image = m.instantiate<sensor_msgs::Image>();
         } else if (topic == image) {
-          sensor_msgs::CompressedImageConstPtr c = m.instantiate<sensor_msgs::CompressedImage>();
+          sensor_msgs::CompressedImageConstPtr c =
+              m.instantiate<sensor_msgs::CompressedImage>();
           sensor_msgs::ImagePtr decoded;
           const steadiface::Status s =
               c ? steadiface_ros::FromCompressedImage(*c, &decoded)
-                : steadiface::Status::Error("not a sensor_msgs/CompressedImage");
+                : steadiface::Status::Error(
+                      "not a sensor_msgs/CompressedImage");
           if (s.ok()) {
             item.image = decoded;
           } else if (decode_failures_++ == 0) {
-            std::cerr << "steadiface_bag: " << s.message() << " (frame skipped)\n";
+            std::cerr << "steadiface_bag: " << s.message()
+                      << " (frame skipped)\n";
           }
         }
         if (!queue->Push(std::move(item))) break;

@@ -10,8 +10,8 @@
 #include <sensor_msgs/Imu.h>
 
 #include "steadiface/FaceLandmarks.h"
-#include "steadiface_core/status.h"
 #include "steadiface_bag/bounded_queue.h"
+#include "steadiface_core/status.h"
 
 namespace steadiface_bag {
 
@@ -44,7 +44,8 @@ struct BagItem {
 /// stabilizer).
 class BagReader {
  public:
-  BagReader(const std::string& path, const BagTopics& topics) : path_(path), topics_(topics) {}
+  BagReader(const std::string& path, const BagTopics& topics)
+      : path_(path), topics_(topics) {}
   ~BagReader();
 
   /// Opens the bag and checks the topics. A missing image topic, a wrong

@@ -18,7 +18,8 @@ namespace {
 using steadiface::Percentile;
 
 // The scorecard's definition of jitter: > cutoff RMS, linear trend removed.
-double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps, double cutoff) {
+double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
+                   double cutoff) {
   return steadiface::eval::Scorecard::HighPassRms(x, fps, cutoff);
 }
 
@@ -51,7 +52,9 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
   double fps_data = 30.0;
   if (sink.states.size() > 2) {
     fps_data = (sink.states.size() - 1) /
-               std::max(1e-9, (sink.states.back().header.stamp - sink.states.front().header.stamp).toSec());
+               std::max(1e-9, (sink.states.back().header.stamp -
+                               sink.states.front().header.stamp)
+                                  .toSec());
   }
   // Ground truth (simulator bags): the true head centre and far-background
   // directions mapped through each frame's warp, as the scorecard does. The
@@ -78,18 +81,23 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       t.head = Eigen::Vector2d(v[2], v[3]);
       t.in_view = v[4] != 0;
       for (int r = 0; r < 16; ++r) {
-        t.rows.emplace_back(v[9 + 4 * r + 3], v[9 + 4 * r], v[9 + 4 * r + 1], v[9 + 4 * r + 2]);
+        t.rows.emplace_back(v[9 + 4 * r + 3], v[9 + 4 * r], v[9 + 4 * r + 1],
+                            v[9 + 4 * r + 2]);
       }
       truth[std::llround(v[1] * 1000.0)] = t;
     }
-    const Eigen::Matrix3d K_in = (Eigen::Matrix3d() << r.input_info.K[0], 0, r.input_info.K[2], 0,
-                                  r.input_info.K[4], r.input_info.K[5], 0, 0, 1).finished();
+    const Eigen::Matrix3d K_in =
+        (Eigen::Matrix3d() << r.input_info.K[0], 0, r.input_info.K[2], 0,
+         r.input_info.K[4], r.input_info.K[5], 0, 0, 1)
+            .finished();
     std::vector<Eigen::Vector2d> h_in, h_out, b_in, b_out;
     Eigen::Vector3d dir = Eigen::Vector3d::Zero();
     std::ofstream traj_none, traj_method;
     if (!r.plot_dir.empty()) {
-      const std::string head = "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
-                               "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
+      const std::string head =
+          "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_"
+          "out_y,"
+          "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
       traj_method.open(r.plot_dir + "/traj_" + r.plot_name + "_" +
                        (r.gyro_only ? "gyro-only" : "steadiface") + ".csv");
       traj_method << head;
@@ -99,7 +107,8 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       }
     }
     const double t0 = sink.states.front().header.stamp.toSec();
-    for (size_t i = 0; i < sink.states.size() && i < sink.infos_out.size(); ++i) {
+    for (size_t i = 0; i < sink.states.size() && i < sink.infos_out.size();
+         ++i) {
       const auto& s = sink.states[i];
       auto it = truth.find(std::llround(s.header.stamp.toSec() * 1000.0));
       if (it == truth.end()) continue;
@@ -108,12 +117,16 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       steadiface_ros::ToEigen(s.virtual_rotation, &Rv);
       steadiface_ros::ToEigen(s.real_rotation, &Rr);
       const auto& ko = sink.infos_out[i].K;
-      const Eigen::Matrix3d K_out = (Eigen::Matrix3d() << ko[0], 0, ko[2], 0, ko[4], ko[5], 0, 0, 1).finished();
-      const Eigen::Matrix3d H = K_out * (Rv * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
+      const Eigen::Matrix3d K_out =
+          (Eigen::Matrix3d() << ko[0], 0, ko[2], 0, ko[4], ko[5], 0, 0, 1)
+              .finished();
+      const Eigen::Matrix3d H =
+          K_out * (Rv * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
       // A far-background direction fixed in the world: the first frame's
       // view centre, seen in each frame through the true middle-row rotation.
       const Eigen::Quaterniond R_true = t.rows[7];
-      if (dir.isZero()) dir = R_true.conjugate() * Eigen::Vector3d(0.05, 0.03, 1.0);
+      if (dir.isZero())
+        dir = R_true.conjugate() * Eigen::Vector3d(0.05, 0.03, 1.0);
       const Eigen::Vector3d c = R_true * dir;
       const Eigen::Vector2d bin = (K_in * c).hnormalized();
       const Eigen::Vector2d bout = (H * bin.homogeneous()).hnormalized();
@@ -125,29 +138,37 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
         h_in.push_back(t.head);
         h_out.push_back(hout);
       }
-      const Eigen::Vector3d vr = steadiface::LogSO3(Rv), rr = steadiface::LogSO3(Rr);
-      auto row = [&](std::ofstream& f, const Eigen::Vector2d& ho, const Eigen::Vector2d& bo,
-                     const Eigen::Vector3d& v, const Eigen::Vector3d& r, double tx, double ty) {
+      const Eigen::Vector3d vr = steadiface::LogSO3(Rv),
+                            rr = steadiface::LogSO3(Rr);
+      auto row = [&](std::ofstream& f, const Eigen::Vector2d& ho,
+                     const Eigen::Vector2d& bo, const Eigen::Vector3d& v,
+                     const Eigen::Vector3d& r, double tx, double ty) {
         if (!f.is_open()) return;
-        f << s.header.stamp.toSec() - t0 << "," << t.head.x() << "," << t.head.y() << "," << ho.x()
-          << "," << ho.y() << "," << t.in_view << "," << bo.x() << "," << bo.y() << "," << v.x()
-          << "," << v.y() << "," << v.z() << "," << r.x() << "," << r.y() << "," << r.z() << ","
+        f << s.header.stamp.toSec() - t0 << "," << t.head.x() << ","
+          << t.head.y() << "," << ho.x() << "," << ho.y() << "," << t.in_view
+          << "," << bo.x() << "," << bo.y() << "," << v.x() << "," << v.y()
+          << "," << v.z() << "," << r.x() << "," << r.y() << "," << r.z() << ","
           << tx << "," << ty << "\n";
       };
-      row(traj_method, hout, bout, vr, rr, s.principal_offset[0], s.principal_offset[1]);
-      row(traj_none, t.in_view ? t.head : Eigen::Vector2d::Constant(NAN), bin, rr, rr, 0.0, 0.0);
+      row(traj_method, hout, bout, vr, rr, s.principal_offset[0],
+          s.principal_offset[1]);
+      row(traj_none, t.in_view ? t.head : Eigen::Vector2d::Constant(NAN), bin,
+          rr, rr, 0.0, 0.0);
     }
     const double diag = std::hypot(r.input_info.width, r.input_info.height);
     std::ostringstream tj;
     tj << ",\n  \"ground_truth\": {\"truth\": \"" << r.truth << "\""
        << ", \"head_jitter_in_px\": " << HighPassRms(h_in, fps_data, 0.5)
        << ", \"head_jitter_out_px\": " << HighPassRms(h_out, fps_data, 0.5)
-       << ", \"head_jitter_out_frac\": " << HighPassRms(h_out, fps_data, 0.5) / diag
+       << ", \"head_jitter_out_frac\": "
+       << HighPassRms(h_out, fps_data, 0.5) / diag
        << ", \"background_jitter_in_px\": " << HighPassRms(b_in, fps_data, 0.5)
-       << ", \"background_jitter_out_px\": " << HighPassRms(b_out, fps_data, 0.5)
+       << ", \"background_jitter_out_px\": "
+       << HighPassRms(b_out, fps_data, 0.5)
        << ", \"cropping\": " << std::pow(1.0 - 2.0 * r.crop_ratio, 2.0)
        << ", \"undefined_fraction\": "
-       << static_cast<double>(ws.stabilizer.undefined_frames) / std::max<size_t>(1, sink.states.size())
+       << static_cast<double>(ws.stabilizer.undefined_frames) /
+              std::max<size_t>(1, sink.states.size())
        << "}";
     truth_json = tj.str();
   }
@@ -156,37 +177,48 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
   if (!sink.states.empty()) {
     const auto& s = sink.states.back();
     std::ostringstream cj;
-    cj << ",\n  \"gyro_video_check\": {\"judged\": " << (s.check_judged ? "true" : "false")
+    cj << ",\n  \"gyro_video_check\": {\"judged\": "
+       << (s.check_judged ? "true" : "false")
        << ", \"motion_px\": " << s.check_motion_px
        << ", \"residual_px\": " << s.check_residual_px
-       << ", \"best_mounting_residual_px\": " << s.check_best_mounting_residual_px
-       << ", \"imu_rotation_contradicts\": " << (s.imu_rotation_contradicts ? "true" : "false")
+       << ", \"best_mounting_residual_px\": "
+       << s.check_best_mounting_residual_px
+       << ", \"imu_rotation_contradicts\": "
+       << (s.imu_rotation_contradicts ? "true" : "false")
        << ", \"suggested_R_cam_imu\": [" << s.suggested_R_cam_imu.x << ", "
        << s.suggested_R_cam_imu.y << ", " << s.suggested_R_cam_imu.z << ", "
        << s.suggested_R_cam_imu.w << "]"
        << ", \"imu_offset_correction_s\": " << s.imu_offset_correction_s
-       << ", \"imu_offset_off\": " << (s.imu_offset_off ? "true" : "false") << "}";
+       << ", \"imu_offset_off\": " << (s.imu_offset_off ? "true" : "false")
+       << "}";
     check_json = cj.str();
     if (s.imu_rotation_contradicts) {
-      std::cerr << "steadiface_bag: WARNING: imu/R_cam_imu contradicts the video (residual "
-                << s.check_residual_px << " px; the axis permutation [" << s.suggested_R_cam_imu.x
-                << ", " << s.suggested_R_cam_imu.y << ", " << s.suggested_R_cam_imu.z << ", "
-                << s.suggested_R_cam_imu.w << "] explains it to " << s.check_best_mounting_residual_px
+      std::cerr << "steadiface_bag: WARNING: imu/R_cam_imu contradicts the "
+                   "video (residual "
+                << s.check_residual_px << " px; the axis permutation ["
+                << s.suggested_R_cam_imu.x << ", " << s.suggested_R_cam_imu.y
+                << ", " << s.suggested_R_cam_imu.z << ", "
+                << s.suggested_R_cam_imu.w << "] explains it to "
+                << s.check_best_mounting_residual_px
                 << " px): set imu/R_cam_imu\n";
     } else if (s.imu_offset_off) {
       std::cerr << "steadiface_bag: WARNING: imu/time_offset is off by "
-                << s.imu_offset_correction_s * 1e3 << " ms (add it to imu/time_offset)\n";
+                << s.imu_offset_correction_s * 1e3
+                << " ms (add it to imu/time_offset)\n";
     }
   }
   std::ostringstream rep;
   rep.precision(6);
-  rep << "{\n  \"input\": \"" << r.in << "\",\n  \"frames_in\": " << ws.counters.images_in
+  rep << "{\n  \"input\": \"" << r.in
+      << "\",\n  \"frames_in\": " << ws.counters.images_in
       << ",\n  \"frames_out\": " << ws.counters.frames_out
-      << ",\n  \"wall_time_s\": " << r.elapsed_s
-      << ",\n  \"throughput_fps\": " << ws.counters.frames_out / std::max(r.elapsed_s, 1e-9)
-      << ",\n  \"landmark_centre_jitter_in_norm\": " << HighPassRms(c_in, fps_data, 0.5)
-      << ",\n  \"target_jitter_out_norm\": " << HighPassRms(c_out, fps_data, 0.5)
-      << ",\n  \"residual_rotation_jitter_rad\": " << HighPassRms(shake, fps_data, 0.5)
+      << ",\n  \"wall_time_s\": " << r.elapsed_s << ",\n  \"throughput_fps\": "
+      << ws.counters.frames_out / std::max(r.elapsed_s, 1e-9)
+      << ",\n  \"landmark_centre_jitter_in_norm\": "
+      << HighPassRms(c_in, fps_data, 0.5) << ",\n  \"target_jitter_out_norm\": "
+      << HighPassRms(c_out, fps_data, 0.5)
+      << ",\n  \"residual_rotation_jitter_rad\": "
+      << HighPassRms(shake, fps_data, 0.5)
       << ",\n  \"crop_ratio\": " << r.crop_ratio
       << ",\n  \"dropped\": {\"bad_image\": " << ws.counters.dropped_bad_image
       << ", \"bad_info\": " << ws.counters.dropped_bad_info
@@ -197,34 +229,42 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       << ",\n  \"passthrough_no_imu\": " << ws.counters.passthrough
       << ",\n  \"extrapolated\": " << ws.counters.extrapolated
       << ",\n  \"protrusion_searches\": " << ws.stabilizer.protrusion_searches
-      << ",\n  \"previous_warp_fallbacks\": " << ws.stabilizer.previous_warp_fallbacks
+      << ",\n  \"previous_warp_fallbacks\": "
+      << ws.stabilizer.previous_warp_fallbacks
       << ",\n  \"undefined_frames\": " << ws.stabilizer.undefined_frames
       << ",\n  \"solver_failures\": " << ws.stabilizer.solver_failures
       << ",\n  \"frames_with_face\": " << ws.stabilizer.frames_with_face
       << ",\n  \"timings_ms\": {"
-      << "\"face\": [" << Percentile(face_ms, 0.5) << ", " << Percentile(face_ms, 0.99) << "], "
-      << "\"stabilizer\": [" << Percentile(stab_ms, 0.5) << ", " << Percentile(stab_ms, 0.99) << "], "
-      << "\"solver\": [" << Percentile(solver_ms, 0.5) << ", " << Percentile(solver_ms, 0.99) << "], "
-      << "\"warp\": [" << Percentile(warp_ms, 0.5) << ", " << Percentile(warp_ms, 0.99) << "], "
-      << "\"total\": [" << Percentile(total_ms, 0.5) << ", " << Percentile(total_ms, 0.99) << "]}"
-      << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5) << check_json << truth_json
-      << ",\n  \"method\": \"" << (r.gyro_only ? "gyro-only" : "steadiface") << "\"\n}\n";
+      << "\"face\": [" << Percentile(face_ms, 0.5) << ", "
+      << Percentile(face_ms, 0.99) << "], "
+      << "\"stabilizer\": [" << Percentile(stab_ms, 0.5) << ", "
+      << Percentile(stab_ms, 0.99) << "], "
+      << "\"solver\": [" << Percentile(solver_ms, 0.5) << ", "
+      << Percentile(solver_ms, 0.99) << "], "
+      << "\"warp\": [" << Percentile(warp_ms, 0.5) << ", "
+      << Percentile(warp_ms, 0.99) << "], "
+      << "\"total\": [" << Percentile(total_ms, 0.5) << ", "
+      << Percentile(total_ms, 0.99) << "]}"
+      << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5)
+      << check_json << truth_json << ",\n  \"method\": \""
+      << (r.gyro_only ? "gyro-only" : "steadiface") << "\"\n}\n";
   return rep.str();
 }
 
 void WriteTrajectory(const std::string& path, const BagSink& sink) {
-    std::ofstream f(path);
-    f.precision(17);
-    f << "stamp,qx,qy,qz,qw,tx,ty,rqx,rqy,rqz,rqw,has_target,hx,hy,cx,cy,w_fit\n";
-    for (const auto& s : sink.states) {
-      f << s.header.stamp.toSec() << "," << s.virtual_rotation.x << "," << s.virtual_rotation.y
-        << "," << s.virtual_rotation.z << "," << s.virtual_rotation.w << ","
-        << s.principal_offset[0] << "," << s.principal_offset[1] << "," << s.real_rotation.x
-        << "," << s.real_rotation.y << "," << s.real_rotation.z << "," << s.real_rotation.w
-        << "," << s.has_target << "," << s.target_h[0] << "," << s.target_h[1] << ","
-        << s.centre_c[0] << "," << s.centre_c[1] << "," << s.w_fit << "\n";
-    }
-  
+  std::ofstream f(path);
+  f.precision(17);
+  f << "stamp,qx,qy,qz,qw,tx,ty,rqx,rqy,rqz,rqw,has_target,hx,hy,cx,cy,w_fit\n";
+  for (const auto& s : sink.states) {
+    f << s.header.stamp.toSec() << "," << s.virtual_rotation.x << ","
+      << s.virtual_rotation.y << "," << s.virtual_rotation.z << ","
+      << s.virtual_rotation.w << "," << s.principal_offset[0] << ","
+      << s.principal_offset[1] << "," << s.real_rotation.x << ","
+      << s.real_rotation.y << "," << s.real_rotation.z << ","
+      << s.real_rotation.w << "," << s.has_target << "," << s.target_h[0] << ","
+      << s.target_h[1] << "," << s.centre_c[0] << "," << s.centre_c[1] << ","
+      << s.w_fit << "\n";
+  }
 }
 
 }  // namespace steadiface_bag

@@ -12,9 +12,10 @@ namespace steadiface_bag {
 
 /// What the report needs to know of the run besides the sink's records.
 struct ReportInputs {
-  std::string in;          ///< input bag path
-  std::string truth;       ///< simulator ground truth CSV ("" = none)
-  std::string plot_dir;    ///< trajectories for scripts/plot_report.py ("" = none)
+  std::string in;     ///< input bag path
+  std::string truth;  ///< simulator ground truth CSV ("" = none)
+  std::string
+      plot_dir;  ///< trajectories for scripts/plot_report.py ("" = none)
   std::string plot_name = "bag";
   bool gyro_only = false;
   double elapsed_s = 0.0;  ///< wall time of the run

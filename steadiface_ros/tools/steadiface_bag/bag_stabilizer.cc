@@ -17,7 +17,9 @@ void BagStabilizer::Process(const BagItem& item) {
   } else if (const auto& img = item.image) {
     const double stamp = img->header.stamp.toSec();
     if (stamp < selection_.start_stamp - 1e-6) return;
-    if (!selection_.only.empty() && !selection_.only.count(std::llround(stamp * 1e3))) return;
+    if (!selection_.only.empty() &&
+        !selection_.only.count(std::llround(stamp * 1e3)))
+      return;
     waiting_.push_back(img);
   }
   // Pair images with the camera_info of the same stamp (either order).
@@ -36,7 +38,8 @@ void BagStabilizer::Process(const BagItem& item) {
     } else {
       auto it = infos_.find(waiting_.front()->header.stamp);
       if (it == infos_.end()) {
-        if (waiting_.size() > 8) {  // no info for this image: use the latest one
+        if (waiting_.size() >
+            8) {  // no info for this image: use the latest one
           if (infos_.empty()) {
             waiting_.pop_front();
             continue;

@@ -26,15 +26,17 @@ struct FrameSelection {
 class BagStabilizer {
  public:
   BagStabilizer(steadiface_ros::StabilizerWrapper* wrapper,
-                steadiface_ros::CameraInfoSource* info_source, bool bag_has_info,
-                const FrameSelection& selection)
+                steadiface_ros::CameraInfoSource* info_source,
+                bool bag_has_info, const FrameSelection& selection)
       : wrapper_(wrapper),
         info_source_(info_source),
         use_file_info_(!bag_has_info && info_source->has_file_info()),
         selection_(selection) {}
 
   /// Called with each image just before the wrapper gets it.
-  void set_on_image(std::function<void(const sensor_msgs::Image&)> f) { on_image_ = std::move(f); }
+  void set_on_image(std::function<void(const sensor_msgs::Image&)> f) {
+    on_image_ = std::move(f);
+  }
 
   void Process(const BagItem& item);
 
@@ -49,7 +51,8 @@ class BagStabilizer {
   const FrameSelection selection_;
   std::function<void(const sensor_msgs::Image&)> on_image_;
   std::map<ros::Time, sensor_msgs::CameraInfoConstPtr> infos_;  // bounded
-  std::deque<sensor_msgs::ImageConstPtr> waiting_;  // images whose info has not arrived
+  std::deque<sensor_msgs::ImageConstPtr>
+      waiting_;  // images whose info has not arrived
   sensor_msgs::CameraInfo in_info_;
   bool have_in_info_ = false;
 };

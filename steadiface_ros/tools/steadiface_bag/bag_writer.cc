@@ -4,8 +4,8 @@
 #include <iostream>
 
 #include <cv_bridge/cv_bridge.h>
-#include <opencv2/imgproc.hpp>
 #include <tf2_msgs/TFMessage.h>
+#include <opencv2/imgproc.hpp>
 
 #include "steadiface_ros/msg_conversion.h"
 
@@ -56,7 +56,8 @@ void BagSink::PublishState(const steadiface::StabilizerState& m) {
   if (out) out->WriteCopy(T("state"), m.header.stamp, m);
 }
 
-void BagSink::PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) {
+void BagSink::PublishTf(
+    const std::vector<geometry_msgs::TransformStamped>& tf) {
   tfs.insert(tfs.end(), tf.begin(), tf.end());
   if (out && !tf.empty()) {
     tf2_msgs::TFMessage m;
@@ -68,7 +69,8 @@ void BagSink::PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) 
 void BagSink::PublishDebugImage(const sensor_msgs::ImagePtr& image) {
   last_debug = image;
   if (out && debug_to_bag) {
-    out->Write(T("debug_image"), image->header.stamp, sensor_msgs::ImageConstPtr(image));
+    out->Write(T("debug_image"), image->header.stamp,
+               sensor_msgs::ImageConstPtr(image));
   }
 }
 
@@ -93,7 +95,8 @@ SideBySideVideo::~SideBySideVideo() {
 void SideBySideVideo::AddInput(const sensor_msgs::Image& image) {
   if (!enabled()) return;
   cv::Mat mat;
-  if (steadiface_ros::ToCvImage(image, &mat).ok()) inputs_[image.header.stamp] = mat.clone();
+  if (steadiface_ros::ToCvImage(image, &mat).ok())
+    inputs_[image.header.stamp] = mat.clone();
   while (inputs_.size() > 32) inputs_.erase(inputs_.begin());
 }
 
@@ -114,7 +117,8 @@ void SideBySideVideo::AddOutput(BagSink* sink) {
   cv::hconcat(left, right, both);
   if (!queue_) {  // first frame: open (the encoder thread owns video_ after)
     const double fps = 30.0;
-    video_.open(tmp_, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps, both.size());
+    video_.open(tmp_, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps,
+                both.size());
     if (!video_.isOpened()) {
       std::cerr << "steadiface_bag: cannot write video '" << tmp_ << "'\n";
       path_.clear();

@@ -7,8 +7,8 @@
 #include <thread>
 #include <vector>
 
-#include <opencv2/videoio.hpp>
 #include <rosbag/bag.h>
+#include <opencv2/videoio.hpp>
 
 #include "steadiface_bag/bounded_queue.h"
 #include "steadiface_ros/stabilizer_wrapper.h"
@@ -23,7 +23,8 @@ class AsyncBagWriter {
   explicit AsyncBagWriter(rosbag::Bag* bag);
   ~AsyncBagWriter() { Finish(); }
   template <typename M>
-  void Write(const std::string& topic, const ros::Time& t, const boost::shared_ptr<const M>& m) {
+  void Write(const std::string& topic, const ros::Time& t,
+             const boost::shared_ptr<const M>& m) {
     rosbag::Bag* bag = bag_;
     queue_.Push([bag, topic, t, m] { bag->write(topic, t, *m); });
   }
@@ -66,7 +67,8 @@ class BagSink : public steadiface_ros::OutputSink {
                     const sensor_msgs::CameraInfoPtr& info) override;
   void PublishLandmarks(const steadiface::FaceLandmarks& m) override;
   void PublishState(const steadiface::StabilizerState& m) override;
-  void PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) override;
+  void PublishTf(
+      const std::vector<geometry_msgs::TransformStamped>& tf) override;
   bool WantsDebugImage() const override { return debug; }
   void PublishDebugImage(const sensor_msgs::ImagePtr& image) override;
   void Warn(const std::string& key, const std::string& text) override;

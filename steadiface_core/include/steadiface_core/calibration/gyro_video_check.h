@@ -87,7 +87,8 @@ struct GyroVideoCheckResult {
 class GyroVideoCheck {
  public:
   /// `R_cam_imu` is the rotation the timeline was built with.
-  static Status Create(const CameraIntrinsics& intrinsics, const RowTiming& timing,
+  static Status Create(const CameraIntrinsics& intrinsics,
+                       const RowTiming& timing,
                        const Eigen::Quaterniond& R_cam_imu,
                        const GyroVideoCheckOptions& options,
                        std::unique_ptr<GyroVideoCheck>* out);
@@ -95,8 +96,8 @@ class GyroVideoCheck {
   /// One frame (8-bit, 1-4 channels, the intrinsics' size) stamped `stamp`;
   /// `face_box` (may be empty) is excluded from tracking. The timeline must
   /// cover the frame's rows plus the offset range (else the pair is skipped).
-  void Process(const cv::Mat& image, Time stamp, const OrientationTimeline& timeline,
-               const cv::Rect2d& face_box);
+  void Process(const cv::Mat& image, Time stamp,
+               const OrientationTimeline& timeline, const cv::Rect2d& face_box);
   void Reset();
   const GyroVideoCheckResult& result() const { return result_; }
 
@@ -105,7 +106,8 @@ class GyroVideoCheck {
 
  private:
   GyroVideoCheck(const CameraIntrinsics& intrinsics, const RowTiming& timing,
-                 const Eigen::Quaterniond& R_cam_imu, const GyroVideoCheckOptions& options);
+                 const Eigen::Quaterniond& R_cam_imu,
+                 const GyroVideoCheckOptions& options);
   // Tracks between frames a and b, waiting until the gyro covers b's rows
   // plus the offset range.
   struct Pending {
@@ -133,7 +135,7 @@ class GyroVideoCheck {
   Time prev_stamp_;
   bool has_prev_ = false;
   uint64_t frame_index_ = 0;
-  std::deque<Pending> pending_;     // bounded (8)
+  std::deque<Pending> pending_;    // bounded (8)
   std::deque<PairRecord> window_;  // bounded by window_s
   GyroVideoCheckResult result_;
 };
