@@ -376,6 +376,9 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   m.previous_warp = f.flags.previous_warp;
   m.undefined_pixels = f.flags.undefined_pixels;
   m.gyro_extrapolated = gyro_extrapolated;
+  m.has_background_layer = f.background.valid;
+  m.background_rotation = ToMsg(f.background.R_v);
+  m.background_principal_offset = {f.background.t.x(), f.background.t.y()};
   const steadiface::GyroVideoCheckResult& c = pf.gyro_video_check;
   m.check_judged = c.judged;
   m.check_motion_px = c.motion_px;

@@ -276,6 +276,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Int("stabilizer/row_rotation_samples", &s.row_rotation_samples, 1, 4096);
   r.Num("stabilizer/min_face_confidence", &s.min_face_confidence, 0.0, 1.0);
   r.Bool("stabilizer/gyro_only", &s.gyro_only);
+  r.Bool("stabilizer/background_layer", &s.background_layer);
   r.Bool("stabilizer/smooth_head_in_virtual_view", &s.smooth_head_in_virtual_view);
   r.Num("stabilizer/intentional_window", &s.intentional_window_s, 0.0, 5.0);
   // Output and warp.

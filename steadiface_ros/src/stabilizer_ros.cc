@@ -1,6 +1,5 @@
 #include "steadiface_ros/stabilizer_ros.h"
 
-
 #include <cmath>
 #include <cstdio>
 
@@ -101,8 +100,9 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   }
   const bool builtin_compressed = !plugin && transport == "compressed";
   if (!plugin && !builtin_compressed) {
-    ROS_ERROR("[%s] image_transport '%s' is not installed (have: raw%s); using raw",
-              name_.c_str(), transport.c_str(), ", compressed (built-in)");
+    ROS_ERROR("[%s] image_transport '%s' is not installed (available: raw, compressed); "
+              "using raw",
+              name_.c_str(), transport.c_str());
     transport = "raw";
   }
   const image_transport::TransportHints hints(builtin_compressed ? "raw" : transport,
@@ -122,10 +122,12 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   timer_ = nh_.createTimer(ros::Duration(0.01), &StabilizerRos::OnTimer, this);
   last_imu_wall_ = ros::WallTime::now();
   ok_ = true;
+  const std::string intrinsics = info_source_->has_file_info()
+                                     ? "camera_info or " + info_source_->url()
+                                     : std::string("camera_info");
   ROS_INFO("[%s] ready: image_raw (%s%s) + %s -> image_stabilized, imu, landmark source %s",
            name_.c_str(), transport.c_str(), builtin_compressed ? ", built-in decoder" : "",
-           info_source_->has_file_info() ? ("camera_info or " + info_source_->url()).c_str()
-                                         : "camera_info",
+           intrinsics.c_str(),
            pipeline_options_.landmark_source == steadiface::LandmarkSource::kDlib
                ? "dlib"
                : pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal

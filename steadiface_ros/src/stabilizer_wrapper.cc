@@ -344,6 +344,15 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
           (frame.stabilizer.R_r * frame.stabilizer.R_v.conjugate()).normalized();
       t.transform = ToTransformMsg(rel);
       if (rel.coeffs().allFinite()) tf.push_back(t);
+      if (frame.stabilizer.background.valid) {
+        // The background layer's virtual camera beside the subject's.
+        geometry_msgs::TransformStamped bt = t;
+        bt.child_frame_id = out_header.frame_id + "_background";
+        const Eigen::Quaterniond brel =
+            (frame.stabilizer.R_r * frame.stabilizer.background.R_v.conjugate()).normalized();
+        bt.transform = ToTransformMsg(brel);
+        if (brel.coeffs().allFinite()) tf.push_back(bt);
+      }
       if (wrapper_options_.publish_world_tf) {
         geometry_msgs::TransformStamped w;
         w.header.stamp = in_header.stamp;

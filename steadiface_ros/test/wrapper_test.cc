@@ -152,6 +152,45 @@ TEST(WrapperTest, CleanStreamIsStabilizedFrameByFrame) {
   for (size_t i = 1; i < stamps.size(); ++i) EXPECT_GT(stamps[i], stamps[i - 1]);
 }
 
+// With stabilizer/background_layer the background layer's virtual camera is
+// published beside the subject's: its TF frame, and its pose in `state`,
+// equal to a gyro-only run's. Off (the default), neither appears.
+TEST(WrapperTest, BackgroundLayerIsPublishedAsItsOwnFrameWhenOn) {
+  Sink off_sink, on_sink, gyro_sink;
+  StabilizerWrapper off(Options(), WrapperOptions(), &off_sink);
+  Feed(&off, TestStream());
+  steadiface::PipelineOptions po = Options();
+  po.stabilizer.background_layer = true;
+  StabilizerWrapper on(po, WrapperOptions(), &on_sink);
+  Feed(&on, TestStream());
+  steadiface::PipelineOptions go = Options();
+  go.stabilizer.gyro_only = true;
+  go.landmark_source = steadiface::LandmarkSource::kNone;
+  StabilizerWrapper gyro(go, WrapperOptions(), &gyro_sink);
+  Feed(&gyro, TestStream());
+  auto count = [](const Sink& s, const std::string& child) {
+    size_t n = 0;
+    for (const auto& t : s.tf) n += t.child_frame_id == child;
+    return n;
+  };
+  EXPECT_EQ(count(off_sink, "cam_stabilized_background"), 0u);
+  EXPECT_EQ(count(on_sink, "cam_stabilized_background"), TestStream().images.size());
+  EXPECT_EQ(count(on_sink, "cam_stabilized"), TestStream().images.size());
+  ASSERT_EQ(on_sink.states.size(), gyro_sink.states.size());
+  ASSERT_EQ(on_sink.states.size(), off_sink.states.size());
+  for (size_t i = 0; i < on_sink.states.size(); ++i) {
+    const auto& a = on_sink.states[i];
+    EXPECT_FALSE(off_sink.states[i].has_background_layer);
+    ASSERT_TRUE(a.has_background_layer);
+    EXPECT_EQ(a.background_rotation.x, gyro_sink.states[i].virtual_rotation.x);
+    EXPECT_EQ(a.background_rotation.w, gyro_sink.states[i].virtual_rotation.w);
+    EXPECT_EQ(a.background_principal_offset[1], gyro_sink.states[i].principal_offset[1]);
+    // The subject layer is as with one layer.
+    EXPECT_EQ(a.virtual_rotation.z, off_sink.states[i].virtual_rotation.z);
+  }
+  ExpectAllFinite(on_sink);
+}
+
 // Latency parts in `state` on the sink's clock: image arrival, waiting for
 // the gyro to cover the last row, publication (the test's clock does not
 // advance during processing). Offline (no clock) they stay 0.

@@ -80,7 +80,8 @@ Stabilizer::Stabilizer(const CameraModel& model, const OutputGeometry& output,
       protrusion_(model, output, options.terms.protrusion_samples_per_edge),
       options_(options),
       smoother_(options.head),
-      dynamic_(options.dynamic) {}
+      dynamic_(options.dynamic),
+      background_dynamic_(options.dynamic) {}
 
 Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
   Status s = ValidateStabilizerOptions(options);
@@ -93,13 +94,17 @@ Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
   options_ = options;
   smoother_ = HeadSmoother(options.head);
   dynamic_.set_options(options.dynamic);
+  background_dynamic_.set_options(options.dynamic);
+  if (!options.background_layer) background_ = LayerState();
   return Status::Ok();
 }
 
 void Stabilizer::reset() {
   subject_ = LayerState();
+  background_ = LayerState();
   has_held_face_ = false;
   dynamic_.reset();
+  background_dynamic_.reset();
   ++stats_.resets;
 }
 
@@ -126,8 +131,11 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   if (!s.ok()) return s;
 
   const bool use_face = FaceUsable(face, options_);
-  const StabilizerWeights w =
-      DynamicWeightsStep(stamp, timeline, layer, use_face ? face : nullptr, dt, &f);
+  // A camera fixed in the world at the epoch's first real rotation: what
+  // it sees does not depend on where the gyro integration started.
+  if (layer.history == 0) R_reference_ = f.R_r;
+  const StabilizerWeights w = DynamicWeightsStep(stamp, timeline, use_face ? face : nullptr, dt,
+                                                 options_.gyro_only, &dynamic_, &f);
 
   Eigen::Quaterniond R_v0;
   Eigen::Vector2d t0;
@@ -141,15 +149,16 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   PoseProblem problem;
   Eigen::Quaterniond R_v = R_v0;
   Eigen::Vector2d t = t0;
-  SolveStep(stamp, timeline, timing, layer, fit_face, w, dt, &problem, &R_v, &t, &f);
+  SolveStep(stamp, timeline, timing, layer, fit_face, w, dt, &problem, &R_v, &t, &f, &stats_);
 
-  ProtrusionStep(layer, &R_v, &t, &f);
+  ProtrusionStep(layer, &R_v, &t, &f, &stats_);
 
   EnergiesStep(R_v, t, &problem, &f);
   f.R_v = R_v;
   f.t = t;
 
   AdvanceStep(stamp, &layer, f);
+  if (options_.background_layer) BackgroundLayer(stamp, timeline, timing, &f);
   ++stats_.frames;
   if (use_face) ++stats_.frames_with_face;
   f.timings.total_ms = MsSince(start);
@@ -188,8 +197,8 @@ Status Stabilizer::RowRotationsStep(Time stamp, const OrientationTimeline& timel
 }
 
 StabilizerWeights Stabilizer::DynamicWeightsStep(Time stamp, const OrientationTimeline& timeline,
-                                                 const LayerState& layer,
                                                  const FaceObservation* face, double dt,
+                                                 bool without_fit, DynamicWeights* dynamic,
                                                  StabilizerFrame* f) {
   // Dynamic weights (§4.4). `face` is null unless usable.
   const auto t_weights = Clock::now();
@@ -199,17 +208,14 @@ StabilizerWeights Stabilizer::DynamicWeightsStep(Time stamp, const OrientationTi
           &mean_speed)) {
     mean_speed = -1.0;
   }
-  // A camera fixed in the world at the epoch's first real rotation: what
-  // it sees does not depend on where the gyro integration started.
-  if (layer.history == 0) R_reference_ = f->R_r;
   Eigen::Vector2d stabilized_centre = Eigen::Vector2d::Zero();
   if (face != nullptr) {
     model_.Project(face->centre, R_reference_, Eigen::Vector2d::Zero(), f->R_r,
                    &stabilized_centre);
   }
-  f->factors = dynamic_.Update(dt, mean_speed, face, stabilized_centre);
+  f->factors = dynamic->Update(dt, mean_speed, face, stabilized_centre);
   StabilizerWeights w = options_.weights;
-  w.fit = options_.gyro_only ? 0.0 : w.fit * f->factors.fit;
+  w.fit = without_fit ? 0.0 : w.fit * f->factors.fit;
   w.rotation_c0 *= f->factors.smoothness;
   w.rotation_c1 *= f->factors.smoothness;
   w.translation_c0 *= f->factors.smoothness;
@@ -309,7 +315,7 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
                            const RowTiming& timing, const LayerState& layer,
                            const FaceObservation* fit_face, const StabilizerWeights& w,
                            double dt, PoseProblem* pp, Eigen::Quaterniond* R_v,
-                           Eigen::Vector2d* t, StabilizerFrame* f) {
+                           Eigen::Vector2d* t, StabilizerFrame* f, StabilizerStats* stats) {
   // Solve (Eq. 5) from the initial pose in *R_v, *t.
   const auto t_solve = Clock::now();
   const Eigen::Quaterniond R_v0 = *R_v;
@@ -413,20 +419,20 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
     *t = t_sol;
   } else {
     f->flags.solver_failed = true;
-    ++stats_.solver_failures;
+    ++stats->solver_failures;
   }
   f->timings.solve_ms = f->solver.time_ms;
 }
 
 void Stabilizer::ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v,
-                                Eigen::Vector2d* t, StabilizerFrame* f) {
+                                Eigen::Vector2d* t, StabilizerFrame* f, StabilizerStats* stats) {
   // Protrusion handling (§4.4): binary search towards the real pose, else
   // the previous warp.
   const auto t_prot = Clock::now();
   const ProtrusionReport check = protrusion_.Check(*R_v, *t, f->rows, 0.0);
   if (!check.defined) {
     f->flags.protrusion_search = true;
-    ++stats_.protrusion_searches;
+    ++stats->protrusion_searches;
     const Eigen::Quaterniond R_sol = *R_v;
     const Eigen::Vector2d t_sol = *t;
     auto pose_at = [&](double s, Eigen::Quaterniond* q, Eigen::Vector2d* tt) {
@@ -451,7 +457,7 @@ void Stabilizer::ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v
       // Nothing valid between P_v and P_r: apply the previous warp, i.e. the
       // same real-to-virtual rotation as on the previous frame.
       f->flags.previous_warp = true;
-      ++stats_.previous_warp_fallbacks;
+      ++stats->previous_warp_fallbacks;
       if (layer.history > 0) {
         *R_v = AlignSign((layer.R_v_prev * layer.R_r_prev.conjugate() * f->R_r).normalized(),
                          layer.R_v_prev);
@@ -463,7 +469,7 @@ void Stabilizer::ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v
       f->flags.undefined_pixels = !protrusion_.Check(*R_v, *t, f->rows, 0.0).defined;
     }
   }
-  if (f->flags.undefined_pixels) ++stats_.undefined_frames;
+  if (f->flags.undefined_pixels) ++stats->undefined_frames;
   f->timings.protrusion_ms = MsSince(t_prot);
 }
 
@@ -478,6 +484,39 @@ void Stabilizer::EnergiesStep(const Eigen::Quaterniond& R_v, const Eigen::Vector
   f->energies.rotation = TermEnergy(&pp->problem, pp->b_rot);
   f->energies.translation = TermEnergy(&pp->problem, pp->b_trans);
   f->energies.protrusion = TermEnergy(&pp->problem, pp->b_prot);
+}
+
+void Stabilizer::BackgroundLayer(Time stamp, const OrientationTimeline& timeline,
+                                 const RowTiming& timing, StabilizerFrame* f) {
+  // The same steps as the subject layer without a face (w_f = 0, no held
+  // face, no head target): exactly what a gyro-only run computes, with this
+  // layer's own trajectory, dynamic weights and counters.
+  LayerState& layer = background_;
+  StabilizerFrame b;
+  b.stamp = stamp;
+  b.rows = f->rows;
+  b.R_r = f->rows.Middle();
+  if (layer.history > 0) b.R_r = AlignSign(b.R_r, layer.R_r_prev);
+  const double dt = layer.history > 0 ? ToSeconds(stamp - layer.last_stamp) : 0.0;
+  b.flags.first_frame = layer.history == 0;
+  const StabilizerWeights w =
+      DynamicWeightsStep(stamp, timeline, nullptr, dt, /*without_fit=*/true,
+                         &background_dynamic_, &b);
+  Eigen::Quaterniond R_v;
+  Eigen::Vector2d t;
+  InitialPoseStep(layer, b, &R_v, &t);
+  PoseProblem problem;
+  SolveStep(stamp, timeline, timing, layer, nullptr, w, dt, &problem, &R_v, &t, &b,
+            &background_stats_);
+  ProtrusionStep(layer, &R_v, &t, &b, &background_stats_);
+  b.R_v = R_v;
+  b.t = t;
+  AdvanceStep(stamp, &layer, b);
+  f->background.valid = true;
+  f->background.R_v = R_v;
+  f->background.t = t;
+  f->background.flags = b.flags;
+  f->background.solver = b.solver;
 }
 
 void Stabilizer::AdvanceStep(Time stamp, LayerState* layer, const StabilizerFrame& f) const {

@@ -88,6 +88,16 @@ struct StabilizerFrame {
   SolverReport solver;
   StabilizerFlags flags;
   StabilizerTimings timings;
+  /// The background layer's pose (StabilizerOptions::background_layer):
+  /// the same optimization without E_f, with its own smoothness state.
+  struct LayerPose {
+    bool valid = false;  ///< solved this frame (background_layer on)
+    Eigen::Quaterniond R_v = Eigen::Quaterniond::Identity();
+    Eigen::Vector2d t = Eigen::Vector2d::Zero();
+    StabilizerFlags flags;
+    SolverReport solver;
+  };
+  LayerPose background;
 };
 
 /// Running counters since start (reset() keeps them).
@@ -163,9 +173,10 @@ class Stabilizer {
                           const RowTiming& timing, const LayerState& layer,
                           StabilizerFrame* f, double* dt);
   // Dynamic weights (§4.4); `face` is null unless usable.
+  // `without_fit`: w_f = 0 (gyro-only, or the background layer).
   StabilizerWeights DynamicWeightsStep(Time stamp, const OrientationTimeline& timeline,
-                                       const LayerState& layer, const FaceObservation* face,
-                                       double dt, StabilizerFrame* f);
+                                       const FaceObservation* face, double dt, bool without_fit,
+                                       DynamicWeights* dynamic, StabilizerFrame* f);
   // Initial pose (Eq. 12).
   void InitialPoseStep(const LayerState& layer, const StabilizerFrame& f,
                        Eigen::Quaterniond* R_v0, Eigen::Vector2d* t0) const;
@@ -183,10 +194,14 @@ class Stabilizer {
   void SolveStep(Time stamp, const OrientationTimeline& timeline, const RowTiming& timing,
                  const LayerState& layer, const FaceObservation* fit_face,
                  const StabilizerWeights& w, double dt, PoseProblem* problem,
-                 Eigen::Quaterniond* R_v, Eigen::Vector2d* t, StabilizerFrame* f);
+                 Eigen::Quaterniond* R_v, Eigen::Vector2d* t, StabilizerFrame* f,
+                 StabilizerStats* stats);
   // Protrusion search towards the real pose, else the previous warp.
   void ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v, Eigen::Vector2d* t,
-                      StabilizerFrame* f);
+                      StabilizerFrame* f, StabilizerStats* stats);
+  // The background layer for this frame (rows from the subject's frame).
+  void BackgroundLayer(Time stamp, const OrientationTimeline& timeline, const RowTiming& timing,
+                       StabilizerFrame* f);
   // Every term's energy at the final pose.
   void EnergiesStep(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
                     PoseProblem* problem, StabilizerFrame* f) const;
@@ -203,6 +218,11 @@ class Stabilizer {
 
   // The face-following layer's trajectory (the paper's one virtual camera).
   LayerState subject_;
+  // The background layer (options_.background_layer): its trajectory, its
+  // dynamic weights (as a gyro-only run's) and its own counters.
+  LayerState background_;
+  DynamicWeights background_dynamic_;
+  StabilizerStats background_stats_;
   // Real rotation of the epoch's first frame: the world-fixed reference
   // camera for the variation measure and the held face (so results do not
   // depend on where gyro integration started).
