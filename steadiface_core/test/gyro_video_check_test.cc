@@ -127,6 +127,20 @@ TEST(GyroVideoCheckTest,
       << "flagged only at frame " << r.frames_to_contradiction;
 }
 
+TEST(GyroVideoCheckTest,
+     APermutedImuWithAnOffsetGetsBothTheMountingAndTheOffset) {
+  // Both wrong at once: each mounting is scored at its own best offset.
+  const Eigen::Matrix3d M =
+      (Eigen::Matrix3d() << 0, 0, 1, 1, 0, 0, 0, 1, 0).finished();
+  const Eigen::Quaterniond R_imu_cam(M);
+  const CheckRun r = Feed(R_imu_cam, 0.030, Eigen::Quaterniond::Identity());
+  ASSERT_TRUE(r.result.judged);
+  EXPECT_TRUE(r.result.rotation_contradicts);
+  EXPECT_LT(AngleDeg(r.result.best_R_cam_imu, R_imu_cam.conjugate()), 1.0);
+  EXPECT_NEAR(r.result.offset_correction_s, 0.030, 0.003);
+  EXPECT_FALSE(r.result.offset_off);  // the rotation must be fixed first
+}
+
 TEST(GyroVideoCheckTest, AThirtyMillisecondClockOffsetIsEstimated) {
   const CheckRun r = Feed(Eigen::Quaterniond::Identity(), 0.030,
                           Eigen::Quaterniond::Identity());
@@ -134,6 +148,9 @@ TEST(GyroVideoCheckTest, AThirtyMillisecondClockOffsetIsEstimated) {
   EXPECT_FALSE(r.result.rotation_contradicts);
   EXPECT_TRUE(r.result.offset_off);
   EXPECT_NEAR(r.result.offset_correction_s, 0.030, 0.003);
+  // The suggested mounting is still the configured one.
+  EXPECT_LT(AngleDeg(r.result.best_R_cam_imu, Eigen::Quaterniond::Identity()),
+            1.0);
 }
 
 }  // namespace

@@ -381,8 +381,9 @@ void StabilizerRos::DiagGyroVideo(diagnostic_updater::DiagnosticStatusWrapper& s
     std::snprintf(text, sizeof(text),
                   "imu/R_cam_imu contradicts the video: the gyro predicts the background's "
                   "motion to %.1f px, the axis permutation %s to %.1f px (of %.1f px motion); "
-                  "set imu/R_cam_imu: %s",
-                  c.residual_configured_px, quat, c.residual_best_mounting_px, c.motion_px, quat);
+                  "set imu/R_cam_imu: %s and add %+.1f ms to imu/time_offset",
+                  c.residual_configured_px, quat, c.residual_best_mounting_px, c.motion_px, quat,
+                  c.offset_correction_s * 1e3);
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN, text);
   } else if (c.offset_off) {
     std::snprintf(text, sizeof(text),

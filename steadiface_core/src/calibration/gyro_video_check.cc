@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <opencv2/imgproc.hpp>
@@ -241,17 +242,23 @@ void GyroVideoCheck::Evaluate(const Pending& p,
   for (size_t i = 0; i < p.xa.size(); ++i)
     r.push_back((p.xb[i] - p.xa[i]).norm());
   rec.motion_px = Median(&r);
-  auto residual = [&](const std::array<Eigen::Quaterniond, kBands>& Ra,
-                      const std::array<Eigen::Quaterniond, kBands>& Rb,
-                      const Eigen::Quaterniond* C) {
+  // Each track's ray in frame a, and its rows' bands.
+  const size_t n = p.xa.size();
+  std::vector<Eigen::Vector3d> ray(n);
+  for (size_t i = 0; i < n; ++i) {
+    ray[i] = Eigen::Vector3d((p.xa[i].x() - k_.cx) / k_.fx,
+                             (p.xa[i].y() - k_.cy) / k_.fy, 1.0);
+  }
+  // Median pixel residual of the tracks when each ray moves by rel[i]
+  // conjugated by C (an alternative mounting: C rel C^T).
+  auto residual = [&](const std::vector<Eigen::Matrix3d>& rel,
+                      const Eigen::Matrix3d* C) {
     r.clear();
-    for (size_t i = 0; i < p.xa.size(); ++i) {
-      Eigen::Quaterniond rel =
-          Rb[band(p.yb[i])] * Ra[band(p.ya[i])].conjugate();
-      if (C != nullptr) rel = *C * rel * C->conjugate();
-      const Eigen::Vector3d ray((p.xa[i].x() - k_.cx) / k_.fx,
-                                (p.xa[i].y() - k_.cy) / k_.fy, 1.0);
-      const Eigen::Vector3d q = rel * ray;
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d q =
+          C != nullptr
+              ? Eigen::Vector3d(*C * (rel[i] * (C->transpose() * ray[i])))
+              : Eigen::Vector3d(rel[i] * ray[i]);
       if (!(q.z() > 1e-6)) {
         r.push_back(1e3);
         continue;
@@ -262,15 +269,27 @@ void GyroVideoCheck::Evaluate(const Pending& p,
     }
     return Median(&r);
   };
-  std::array<Eigen::Quaterniond, kBands> Ra, Rb;
-  for (double off : offsets_) {
-    if (!rotations(p.a, off, &Ra) || !rotations(p.b, off, &Rb)) return;
-    rec.offset_residual.push_back(residual(Ra, Rb, nullptr));
+  const auto& perms = SignedAxisPermutations();
+  std::vector<Eigen::Matrix3d> C(perms.size());
+  for (size_t m = 0; m < perms.size(); ++m) {
+    C[m] = (perms[m] * R_cam_imu_.conjugate()).normalized().toRotationMatrix();
   }
-  if (!rotations(p.a, 0.0, &Ra) || !rotations(p.b, 0.0, &Rb)) return;
-  for (const Eigen::Quaterniond& P : SignedAxisPermutations()) {
-    const Eigen::Quaterniond C = (P * R_cam_imu_.conjugate()).normalized();
-    rec.mounting_residual.push_back(residual(Ra, Rb, &C));
+  rec.grid.resize(perms.size() * offsets_.size());
+  std::array<Eigen::Quaterniond, kBands> Ra, Rb;
+  std::vector<Eigen::Matrix3d> rel(n);
+  for (size_t o = 0; o < offsets_.size(); ++o) {
+    if (!rotations(p.a, offsets_[o], &Ra) ||
+        !rotations(p.b, offsets_[o], &Rb)) {
+      return;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      rel[i] = (Rb[band(p.yb[i])] * Ra[band(p.ya[i])].conjugate())
+                   .toRotationMatrix();
+    }
+    rec.offset_residual.push_back(residual(rel, nullptr));
+    for (size_t m = 0; m < perms.size(); ++m) {
+      rec.grid[m * offsets_.size() + o] = residual(rel, &C[m]);
+    }
   }
   window_.push_back(std::move(rec));
 }
@@ -287,37 +306,60 @@ void GyroVideoCheck::Judge() {
     result_ = res;
     return;
   }
-  std::vector<double> off(offsets_.size(), 0.0);
-  std::vector<double> mount(SignedAxisPermutations().size(), 0.0);
+  const size_t n_off = offsets_.size(),
+               n_mount = SignedAxisPermutations().size();
+  std::vector<double> off(n_off, 0.0), grid(n_off * n_mount, 0.0);
   for (const PairRecord& p : window_) {
     res.motion_px += p.motion_px;
-    for (size_t i = 0; i < off.size(); ++i) off[i] += p.offset_residual[i];
-    for (size_t i = 0; i < mount.size(); ++i)
-      mount[i] += p.mounting_residual[i];
+    for (size_t i = 0; i < n_off; ++i) off[i] += p.offset_residual[i];
+    for (size_t i = 0; i < grid.size(); ++i) grid[i] += p.grid[i];
   }
   const double n = static_cast<double>(window_.size());
   res.motion_px /= n;
-  const size_t zero = offsets_.size() / 2;  // the configured offset
-  res.residual_configured_px = off[zero] / n;
-  const size_t best_m =
-      std::min_element(mount.begin(), mount.end()) - mount.begin();
-  res.residual_best_mounting_px = mount[best_m] / n;
+  // The minimum of a residual curve over the offsets, refined by a parabola
+  // through its neighbours: the offset hypothesis delta (the timeline read
+  // at t + delta matches the video at t) and the curve's minimum.
+  auto best_offset = [&](const double* curve, double* delta) {
+    const size_t b = std::min_element(curve, curve + n_off) - curve;
+    *delta = offsets_[b];
+    if (b > 0 && b + 1 < n_off) {
+      const double denom = curve[b - 1] - 2.0 * curve[b] + curve[b + 1];
+      if (denom > 1e-12) {
+        *delta += 0.5 * options_.offset_step_s * (curve[b - 1] - curve[b + 1]) /
+                  denom;
+      }
+    }
+    return curve[b];
+  };
+  // The configured mounting, at its best offset; every signed permutation
+  // at its own best offset (so an offset error does not condemn the
+  // rotation, nor a wrong rotation the offset).
+  double configured_delta = 0.0;
+  const double configured_min = best_offset(off.data(), &configured_delta) / n;
+  res.residual_configured_px = configured_min;
+  size_t best_m = 0;
+  double best_min = std::numeric_limits<double>::infinity(), best_delta = 0.0;
+  for (size_t m = 0; m < n_mount; ++m) {
+    double d = 0.0;
+    const double v = best_offset(&grid[m * n_off], &d) / n;
+    if (v < best_min) {
+      best_min = v;
+      best_m = m;
+      best_delta = d;
+    }
+  }
+  res.residual_best_mounting_px = best_min;
   res.best_R_cam_imu = SignedAxisPermutations()[best_m];
   res.judged = res.pairs >= options_.min_pairs &&
                res.motion_px >= options_.min_motion_px;
-  res.rotation_contradicts = res.judged && res.residual_best_mounting_px <
-                                               options_.better_mounting_ratio *
-                                                   res.residual_configured_px;
-  // Offset: the best hypothesis, refined by a parabola through its
-  // neighbours; the correction to add to imu/time_offset is its negative.
-  const size_t b = std::min_element(off.begin(), off.end()) - off.begin();
-  double delta = offsets_[b];
-  if (b > 0 && b + 1 < off.size()) {
-    const double denom = off[b - 1] - 2.0 * off[b] + off[b + 1];
-    if (denom > 1e-12)
-      delta += 0.5 * options_.offset_step_s * (off[b - 1] - off[b + 1]) / denom;
-  }
-  res.offset_correction_s = -delta;
+  res.rotation_contradicts =
+      res.judged && res.residual_best_mounting_px <
+                        options_.better_mounting_ratio * configured_min;
+  // The correction to add to imu/time_offset is the hypothesis' negative,
+  // for the mounting that explains the video (the suggested one when the
+  // configured rotation contradicts it).
+  res.offset_correction_s =
+      -(res.rotation_contradicts ? best_delta : configured_delta);
   res.offset_off = res.judged && !res.rotation_contradicts &&
                    std::abs(res.offset_correction_s) > options_.offset_warn_s;
   result_ = res;

@@ -200,7 +200,9 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
                 << ", " << s.suggested_R_cam_imu.z << ", "
                 << s.suggested_R_cam_imu.w << "] explains it to "
                 << s.check_best_mounting_residual_px
-                << " px): set imu/R_cam_imu\n";
+                << " px): set imu/R_cam_imu, and add "
+                << s.imu_offset_correction_s * 1e3
+                << " ms to imu/time_offset\n";
     } else if (s.imu_offset_off) {
       std::cerr << "steadiface_bag: WARNING: imu/time_offset is off by "
                 << s.imu_offset_correction_s * 1e3

@@ -38,8 +38,8 @@ void BagStabilizer::Process(const BagItem& item) {
     } else {
       auto it = infos_.find(waiting_.front()->header.stamp);
       if (it == infos_.end()) {
-        if (waiting_.size() >
-            8) {  // no info for this image: use the latest one
+        // No info for this image after 8 more: use the latest one.
+        if (waiting_.size() > 8) {
           if (infos_.empty()) {
             waiting_.pop_front();
             continue;

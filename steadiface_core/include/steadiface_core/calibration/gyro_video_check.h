@@ -58,8 +58,8 @@ struct GyroVideoCheckResult {
   double motion_px = 0.0;
   /// Window mean of the per-pair median reprojection residual of the
   /// features under the gyro's rotation [px]: with the configured IMU
-  /// rotation and offset, and with the best of the 24 signed axis
-  /// permutations.
+  /// rotation, and with the best of the 24 signed axis permutations, each at
+  /// its best clock offset.
   double residual_configured_px = 0.0;
   double residual_best_mounting_px = 0.0;
   /// Another signed axis permutation explains the image motion much better
@@ -67,8 +67,10 @@ struct GyroVideoCheckResult {
   bool rotation_contradicts = false;
   /// The best signed axis permutation, as an imu/R_cam_imu to configure.
   Eigen::Quaterniond best_R_cam_imu = Eigen::Quaterniond::Identity();
-  /// Estimated correction to add to imu/time_offset [s], and whether it
-  /// exceeds offset_warn_s (only meaningful when the rotation agrees).
+  /// Estimated correction to add to imu/time_offset [s] (for the suggested
+  /// mounting when the configured rotation contradicts the video), and
+  /// whether it exceeds offset_warn_s (only judged when the rotation
+  /// agrees).
   double offset_correction_s = 0.0;
   bool offset_off = false;
 };
@@ -118,8 +120,8 @@ class GyroVideoCheck {
   struct PairRecord {
     Time stamp;
     double motion_px = 0.0;
-    std::vector<double> offset_residual;    // per offset hypothesis
-    std::vector<double> mounting_residual;  // per signed permutation
+    std::vector<double> offset_residual;  // configured mounting, per offset
+    std::vector<double> grid;  // [permutation * offsets + offset]
   };
   void EvaluateReady(const OrientationTimeline& timeline);
   void Evaluate(const Pending& p, const OrientationTimeline& timeline);
