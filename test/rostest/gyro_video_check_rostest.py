@@ -16,6 +16,7 @@ import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
 from steadiface.msg import StabilizerState
+from stabilizer_rostest import quat_to_R
 
 ARGS = None
 
@@ -77,10 +78,7 @@ class GyroVideoCheckTest(unittest.TestCase):
             # The bag's IMU: R_imu_cam swaps x and y and flips z (its own
             # inverse), so imu/R_cam_imu should be that rotation.
             M = np.array([[0, 1, 0], [1, 0, 0], [0, 0, -1.0]])
-            R = np.array([
-                [1 - 2 * (q.y ** 2 + q.z ** 2), 2 * (q.x * q.y - q.z * q.w), 2 * (q.x * q.z + q.y * q.w)],
-                [2 * (q.x * q.y + q.z * q.w), 1 - 2 * (q.x ** 2 + q.z ** 2), 2 * (q.y * q.z - q.x * q.w)],
-                [2 * (q.x * q.z - q.y * q.w), 2 * (q.y * q.z + q.x * q.w), 1 - 2 * (q.x ** 2 + q.y ** 2)]])
+            R = quat_to_R(q)
             self.assertLess(np.abs(R - M.T).max(), 1e-6, R)
         else:
             self.assertIn("imu/time_offset", warns[0][1].message)
