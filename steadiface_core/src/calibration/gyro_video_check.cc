@@ -106,6 +106,12 @@ GyroVideoCheck::GyroVideoCheck(const CameraIntrinsics& intrinsics,
   const int n = static_cast<int>(
       std::floor(options.offset_range_s / options.offset_step_s + 1e-9));
   for (int i = -n; i <= n; ++i) offsets_.push_back(i * options.offset_step_s);
+  // Each signed permutation P as a change of the configured mounting:
+  // C = P R_cam_imu^-1 (a relative rotation under P is C rel C^T).
+  for (const Eigen::Quaterniond& P : SignedAxisPermutations()) {
+    mountings_.push_back(
+        (P * R_cam_imu_.conjugate()).normalized().toRotationMatrix());
+  }
 }
 
 void GyroVideoCheck::Reset() {
@@ -269,12 +275,7 @@ void GyroVideoCheck::Evaluate(const Pending& p,
     }
     return Median(&r);
   };
-  const auto& perms = SignedAxisPermutations();
-  std::vector<Eigen::Matrix3d> C(perms.size());
-  for (size_t m = 0; m < perms.size(); ++m) {
-    C[m] = (perms[m] * R_cam_imu_.conjugate()).normalized().toRotationMatrix();
-  }
-  rec.grid.resize(perms.size() * offsets_.size());
+  rec.grid.resize(mountings_.size() * offsets_.size());
   std::array<Eigen::Quaterniond, kBands> Ra, Rb;
   std::vector<Eigen::Matrix3d> rel(n);
   for (size_t o = 0; o < offsets_.size(); ++o) {
@@ -287,8 +288,8 @@ void GyroVideoCheck::Evaluate(const Pending& p,
                    .toRotationMatrix();
     }
     rec.offset_residual.push_back(residual(rel, nullptr));
-    for (size_t m = 0; m < perms.size(); ++m) {
-      rec.grid[m * offsets_.size() + o] = residual(rel, &C[m]);
+    for (size_t m = 0; m < mountings_.size(); ++m) {
+      rec.grid[m * offsets_.size() + o] = residual(rel, &mountings_[m]);
     }
   }
   window_.push_back(std::move(rec));

@@ -189,11 +189,16 @@ Status Stabilizer::RowRotationsStep(Time stamp, const OrientationTimeline& timel
         std::to_string(ToSeconds(timing.FirstRowTime(stamp))) + " s, last row " +
         std::to_string(ToSeconds(timing.LastRowTime(stamp))) + " s)");
   }
+  StartLayerFrame(layer, stamp, f, dt);
+  return Status::Ok();
+}
+
+void Stabilizer::StartLayerFrame(const LayerState& layer, Time stamp, StabilizerFrame* f,
+                                 double* dt) const {
   f->R_r = f->rows.Middle();
   if (layer.history > 0) f->R_r = AlignSign(f->R_r, layer.R_r_prev);
   *dt = layer.history > 0 ? ToSeconds(stamp - layer.last_stamp) : 0.0;
   f->flags.first_frame = layer.history == 0;
-  return Status::Ok();
 }
 
 StabilizerWeights Stabilizer::DynamicWeightsStep(Time stamp, const OrientationTimeline& timeline,
@@ -495,10 +500,8 @@ void Stabilizer::BackgroundLayer(Time stamp, const OrientationTimeline& timeline
   StabilizerFrame b;
   b.stamp = stamp;
   b.rows = f->rows;
-  b.R_r = f->rows.Middle();
-  if (layer.history > 0) b.R_r = AlignSign(b.R_r, layer.R_r_prev);
-  const double dt = layer.history > 0 ? ToSeconds(stamp - layer.last_stamp) : 0.0;
-  b.flags.first_frame = layer.history == 0;
+  double dt = 0.0;
+  StartLayerFrame(layer, stamp, &b, &dt);
   const StabilizerWeights w =
       DynamicWeightsStep(stamp, timeline, nullptr, dt, /*without_fit=*/true,
                          &background_dynamic_, &b);

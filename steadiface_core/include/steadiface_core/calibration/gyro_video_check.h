@@ -133,6 +133,8 @@ class GyroVideoCheck {
   const GyroVideoCheckOptions options_;
   double scale_ = 1.0;  // tracking image / full image
   std::vector<double> offsets_;
+  // The 24 signed permutations as changes of the configured mounting.
+  std::vector<Eigen::Matrix3d> mountings_;
   cv::Mat prev_grey_;
   Time prev_stamp_;
   bool has_prev_ = false;

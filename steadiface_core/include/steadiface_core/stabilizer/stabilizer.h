@@ -172,6 +172,11 @@ class Stabilizer {
   Status RowRotationsStep(Time stamp, const OrientationTimeline& timeline,
                           const RowTiming& timing, const LayerState& layer,
                           StabilizerFrame* f, double* dt);
+  // A layer's view of a frame whose rows are built: R_r (middle row, sign
+  // aligned with the layer's previous one), the time since the layer's
+  // previous frame, the first-frame flag.
+  void StartLayerFrame(const LayerState& layer, Time stamp, StabilizerFrame* f,
+                       double* dt) const;
   // Dynamic weights (§4.4); `face` is null unless usable.
   // `without_fit`: w_f = 0 (gyro-only, or the background layer).
   StabilizerWeights DynamicWeightsStep(Time stamp, const OrientationTimeline& timeline,
