@@ -2,9 +2,11 @@
 
 #include <string>
 
+#include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "steadiface_core/camera_model.h"
 #include "steadiface_core/time.h"
 
 namespace steadiface {
@@ -19,6 +21,15 @@ inline cv::Mat LoadImage(const std::string& name) {
 }
 
 inline Time At(double seconds) { return Time(FromSeconds(seconds)); }
+
+/// The stabilizer tests' camera: 640x360, 1.2 rad horizontal field of view.
+inline CameraModel Model640x360() {
+  CameraModel m;
+  EXPECT_TRUE(CameraModel::Create(IntrinsicsFromHorizontalFov(640, 360, 1.2),
+                                  CameraModelOptions(), &m)
+                  .ok());
+  return m;
+}
 
 }  // namespace testing_util
 }  // namespace steadiface
