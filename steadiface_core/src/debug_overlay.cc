@@ -110,4 +110,59 @@ void DrawDebugOverlay(const cv::Mat& input, const CameraModel& model,
   }
 }
 
+void DrawLayeredOverlay(const WarpMesh& mesh, const SubjectRegion& region,
+                        const LayerBlendReport& blend, int output_width, int output_height,
+                        cv::Mat* out) {
+  if (mesh.cols < 2 || mesh.rows < 2 || output_width < 2 || output_height < 2) return;
+  const double s = std::max(1.0, out->cols / 640.0);
+  const int th = static_cast<int>(std::lround(s));
+  // The mesh's source of an output point (bilinear in its cell).
+  auto source = [&mesh](double u, double v) {
+    int i = 0, j = 0;
+    while (i + 2 < mesh.cols && mesh.u[i + 1] < u) ++i;
+    while (j + 2 < mesh.rows && mesh.v[j + 1] < v) ++j;
+    const double a = std::min(1.0, std::max(0.0, (u - mesh.u[i]) / (mesh.u[i + 1] - mesh.u[i])));
+    const double b = std::min(1.0, std::max(0.0, (v - mesh.v[j]) / (mesh.v[j + 1] - mesh.v[j])));
+    auto q = [&](int ii, int jj) { return mesh.source[jj * mesh.cols + ii].cast<double>(); };
+    const Eigen::Vector2d p = (1 - a) * (1 - b) * q(i, j) + a * (1 - b) * q(i + 1, j) +
+                              (1 - a) * b * q(i, j + 1) + a * b * q(i + 1, j + 1);
+    return cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  };
+  if (region.valid && region.blend > 0.0) {
+    // Level sets of the region's signed distance on a coarse output grid.
+    const int step = std::max(2, output_width / 160);
+    const int gw = output_width / step + 1, gh = output_height / step + 1;
+    const cv::Scalar orange(0, 140, 255), blue(255, 120, 0);
+    const double inner = blend.band_outer_px - blend.band_px;
+    for (const auto& level : {std::make_pair(0.0, orange), std::make_pair(inner, blue),
+                              std::make_pair(blend.band_outer_px, blue)}) {
+      cv::Mat mask(gh, gw, CV_8UC1);
+      for (int y = 0; y < gh; ++y) {
+        for (int x = 0; x < gw; ++x) {
+          mask.at<uchar>(y, x) =
+              region.SignedDistance(Eigen::Vector2d(x * step, y * step)) <= level.first ? 255 : 0;
+        }
+      }
+      std::vector<std::vector<cv::Point>> contours;
+      cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+      for (const auto& c : contours) {
+        std::vector<cv::Point2f> poly;
+        for (const auto& p : c) poly.push_back(source(p.x * step, p.y * step));
+        std::vector<cv::Point> ipoly;
+        for (const auto& p : poly) ipoly.emplace_back(cvRound(p.x), cvRound(p.y));
+        cv::polylines(*out, ipoly, true, level.second, th, cv::LINE_AA);
+      }
+    }
+  }
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "layered g %.2f  offset %.1f->%.1f px  shift %.1f px  cell %.2f%s",
+                region.blend, blend.offset_px, blend.capped_offset_px, blend.shift_px,
+                blend.min_cell_ratio, blend.protrusion_keep < 1.0 ? "  pulled" : "");
+  const cv::Point at(static_cast<int>(8 * s), out->rows - static_cast<int>(10 * s));
+  cv::putText(*out, buf, at, cv::FONT_HERSHEY_SIMPLEX, 0.5 * s, cv::Scalar(0, 0, 0), th + 2,
+              cv::LINE_AA);
+  cv::putText(*out, buf, at, cv::FONT_HERSHEY_SIMPLEX, 0.5 * s, cv::Scalar(255, 255, 255), th,
+              cv::LINE_AA);
+}
+
 }  // namespace steadiface

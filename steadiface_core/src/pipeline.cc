@@ -34,7 +34,8 @@ Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
     : model_(model),
       options_(options),
       timing_(options.shutter, model.intrinsics().height),
-      timeline_(options.imu) {}
+      timeline_(options.imu),
+      region_(new SubjectRegionTracker(options.warp.layered.region)) {}
 
 Status Pipeline::Create(const CameraIntrinsics& intrinsics,
                         const PipelineOptions& options,
@@ -44,7 +45,10 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
   CameraModel model;
   s = CameraModel::Create(intrinsics, options.camera, &model);
   if (!s.ok()) return s;
-  std::unique_ptr<Pipeline> p(new Pipeline(model, options));
+  PipelineOptions o = options;
+  // The layered warp needs the background layer's pose every frame.
+  if (o.warp.mode == WarpMode::kLayered) o.stabilizer.background_layer = true;
+  std::unique_ptr<Pipeline> p(new Pipeline(model, o));
   if (options.landmark_source != LandmarkSource::kNone) {
     // External landmarks still go through the tracker's checks and
     // face-of-interest logic (no model file needed for them, but the
@@ -53,8 +57,7 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
     s = FaceTracker::Create(model, fo, &p->tracker_);
     if (!s.ok()) return s;
   }
-  s = Stabilizer::Create(model, options.warp.output, options.stabilizer,
-                         &p->stabilizer_);
+  s = Stabilizer::Create(model, options.warp.output, o.stabilizer, &p->stabilizer_);
   if (!s.ok()) return s;
   s = Warper::Create(model, options.warp, &p->warper_);
   if (!s.ok()) return s;
@@ -121,8 +124,36 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   f.timings.stabilizer_ms = MsSince(t_stab);
   if (!s.ok()) return s;
   // Warp.
-  f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(f.stabilizer.t);
-  if (options_.render_output) {
+  const bool layered = options_.warp.mode == WarpMode::kLayered;
+  f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(
+      layered && f.stabilizer.background.valid ? f.stabilizer.background.t : f.stabilizer.t);
+  if (layered) {
+    // The subject region from this frame's face, through the subject layer.
+    const double dt = has_last_stamp_ ? ToSeconds(stamp) - ToSeconds(last_stamp_) : 0.0;
+    f.layered.active = true;
+    f.layered.region = region_->Update(model_, warper_->output_geometry(), f.stabilizer.R_v,
+                                      f.stabilizer.t, f.stabilizer.rows, obs,
+                                      f.stabilizer.factors.presence_target, dt);
+    const StabilizerFrame::LayerPose& b = f.stabilizer.background;
+    s = warper_->ComputeLayeredMesh(f.stabilizer.R_v, f.stabilizer.t, b.valid ? b.R_v : f.stabilizer.R_v,
+                                    b.valid ? b.t : f.stabilizer.t, f.stabilizer.rows,
+                                    f.layered.region, dt);
+    f.layered.blend = warper_->blend_report();
+    f.timings.mesh_ms = warper_->timings().mesh_ms;
+    if (s.ok() && options_.render_output) {
+      warper_->BuildMaps();
+      s = warper_->Remap(image, &f.output);
+      f.timings.maps_ms = warper_->timings().maps_ms;
+      f.timings.remap_ms = warper_->timings().remap_ms;
+    }
+    has_last_stamp_ = true;
+    last_stamp_ = stamp;
+    if (!s.ok()) {
+      f.output.release();
+      *out = std::move(f);
+      return s;
+    }
+  } else if (options_.render_output) {
     s = warper_->Warp(image, f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows,
                       &f.output);
     f.timings.mesh_ms = warper_->timings().mesh_ms;
@@ -153,9 +184,32 @@ Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
 }
 
 Status Pipeline::UpdateStabilizerOptions(const StabilizerOptions& options) {
-  Status s = stabilizer_->UpdateOptions(options);
-  if (s.ok()) options_.stabilizer = options;
+  StabilizerOptions o = options;
+  if (options_.warp.mode == WarpMode::kLayered) o.background_layer = true;
+  Status s = stabilizer_->UpdateOptions(o);
+  if (s.ok()) options_.stabilizer = o;
   return s;
+}
+
+Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered) {
+  WarpOptions w = options_.warp;
+  w.mode = mode;
+  w.layered = layered;
+  std::unique_ptr<Warper> warper;
+  Status s = Warper::Create(model_, w, &warper);
+  if (!s.ok()) return s;
+  if (mode == WarpMode::kLayered && !options_.stabilizer.background_layer) {
+    StabilizerOptions so = options_.stabilizer;
+    so.background_layer = true;
+    s = stabilizer_->UpdateOptions(so);
+    if (!s.ok()) return s;
+    options_.stabilizer = so;
+  }
+  warper_ = std::move(warper);
+  options_.warp = w;
+  region_.reset(new SubjectRegionTracker(layered.region));
+  has_last_stamp_ = false;
+  return Status::Ok();
 }
 
 void Pipeline::Reset() {
@@ -163,6 +217,9 @@ void Pipeline::Reset() {
   if (tracker_ != nullptr) tracker_->reset();
   stabilizer_->reset();
   if (check_ != nullptr) check_->Reset();
+  region_->reset();
+  warper_->reset();
+  has_last_stamp_ = false;
 }
 
 }  // namespace steadiface

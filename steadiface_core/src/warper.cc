@@ -24,9 +24,34 @@ constexpr int kInterTabSize = 1 << kInterBits;
 
 }  // namespace
 
+Status ParseWarpMode(const std::string& name, WarpMode* mode) {
+  if (name == "global") {
+    *mode = WarpMode::kGlobal;
+  } else if (name == "layered") {
+    *mode = WarpMode::kLayered;
+  } else {
+    return Status::Error("warp.mode must be 'global' or 'layered', got '" + name + "'");
+  }
+  return Status::Ok();
+}
+
+const char* WarpModeName(WarpMode mode) {
+  return mode == WarpMode::kLayered ? "layered" : "global";
+}
+
 Status ValidateWarpOptions(const WarpOptions& o) {
   Status s = ValidateOutputOptions(o.output);
   if (!s.ok()) return s;
+  if (o.mode == WarpMode::kLayered) {
+    s = ValidateSubjectRegionOptions(o.layered.region);
+    if (!s.ok()) return s;
+    s = ValidateLayerBlendOptions(o.layered.blend);
+    if (!s.ok()) return s;
+    if (o.layered.mesh_cols < 2 || o.layered.mesh_cols > 512 || o.layered.mesh_rows < 2 ||
+        o.layered.mesh_rows > 512) {
+      return Status::Error("warp.layered.mesh_cols/mesh_rows must be in [2, 512]");
+    }
+  }
   std::ostringstream err;
   if (o.mesh_cols < 1 || o.mesh_cols > 512 || o.mesh_rows < 1 ||
       o.mesh_rows > 512) {
@@ -49,6 +74,21 @@ Status ValidateWarpOptions(const WarpOptions& o) {
   return Status::Ok();
 }
 
+bool SameLayering(WarpMode mode, const LayeredWarpOptions& a, const WarpOptions& options) {
+  const LayeredWarpOptions& b = options.layered;
+  const SubjectRegionOptions &ra = a.region, &rb = b.region;
+  const LayerBlendOptions &ba = a.blend, &bb = b.blend;
+  return mode == options.mode && a.mesh_cols == b.mesh_cols && a.mesh_rows == b.mesh_rows &&
+         ra.head_width_scale == rb.head_width_scale && ra.head_top_scale == rb.head_top_scale &&
+         ra.torso == rb.torso && ra.shoulder_width_scale == rb.shoulder_width_scale &&
+         ra.neck_width_scale == rb.neck_width_scale && ra.smoothing_s == rb.smoothing_s &&
+         ra.ramp_s == rb.ramp_s && ba.band_width == bb.band_width &&
+         ba.band_inside == bb.band_inside && ba.max_offset == bb.max_offset &&
+         ba.offset_lowpass_hz == bb.offset_lowpass_hz &&
+         ba.band_data_weight == bb.band_data_weight && ba.shape_weight == bb.shape_weight &&
+         ba.temporal_weight == bb.temporal_weight;
+}
+
 Status Warper::Create(const CameraModel& model, const WarpOptions& options,
                       std::unique_ptr<Warper>* out) {
   Status s = ValidateWarpOptions(options);
@@ -67,7 +107,9 @@ Warper::Warper(const CameraModel& model, const WarpOptions& options,
       options_(options),
       output_(output),
       protrusion_(model, output, options.protrusion_samples_per_edge) {
-  int cols = options.mesh_cols, rows = options.mesh_rows;
+  const bool layered = options.mode == WarpMode::kLayered;
+  int cols = layered ? options.layered.mesh_cols : options.mesh_cols;
+  int rows = layered ? options.layered.mesh_rows : options.mesh_rows;
   if (model.intrinsics().HasDistortion()) {
     const int cell = options.distortion_cell_px;
     cols = std::max(cols, (output.width() + cell - 1) / cell);
@@ -85,12 +127,12 @@ Warper::Warper(const CameraModel& model, const WarpOptions& options,
   }
   mesh_.source.resize(mesh_.cols * mesh_.rows);
   mesh_.source_row.resize(mesh_.cols * mesh_.rows);
+  if (layered) blend_.reset(new LayerBlend(mesh_.u, mesh_.v, options.layered.blend));
 }
 
-Status Warper::ComputeMesh(const Eigen::Quaterniond& R_v,
-                           const Eigen::Vector2d& t,
-                           const RowRotations& rows) {
-  const auto start = std::chrono::steady_clock::now();
+Status Warper::MeshForPose(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+                           const RowRotations& rows, std::vector<Eigen::Vector2f>* source,
+                           std::vector<float>* source_row) const {
   if (!R_v.coeffs().allFinite() || std::abs(R_v.norm() - 1.0) > 1e-6 ||
       !t.allFinite()) {
     return Status::Error("warp: non-finite or non-unit virtual pose refused");
@@ -98,6 +140,8 @@ Status Warper::ComputeMesh(const Eigen::Quaterniond& R_v,
   if (rows.empty() || rows.height() != model_.intrinsics().height) {
     return Status::Error("warp: row rotations missing or for another size");
   }
+  source->resize(static_cast<size_t>(mesh_.cols) * mesh_.rows);
+  source_row->resize(source->size());
   double row = 0.5 * (rows.height() - 1);
   for (int j = 0; j < mesh_.rows; ++j) {
     for (int i = 0; i < mesh_.cols; ++i) {
@@ -113,12 +157,37 @@ Status Warper::ComputeMesh(const Eigen::Quaterniond& R_v,
             "camera");
       }
       const size_t k = static_cast<size_t>(j) * mesh_.cols + i;
-      mesh_.source[k] = p.cast<float>();
-      mesh_.source_row[k] = static_cast<float>(row);
+      (*source)[k] = p.cast<float>();
+      (*source_row)[k] = static_cast<float>(row);
     }
     // Next mesh row starts from this row's first vertex.
-    row = mesh_.source_row[static_cast<size_t>(j) * mesh_.cols];
+    row = (*source_row)[static_cast<size_t>(j) * mesh_.cols];
   }
+  return Status::Ok();
+}
+
+Status Warper::ComputeMesh(const Eigen::Quaterniond& R_v,
+                           const Eigen::Vector2d& t,
+                           const RowRotations& rows) {
+  const auto start = std::chrono::steady_clock::now();
+  Status s = MeshForPose(R_v, t, rows, &mesh_.source, &mesh_.source_row);
+  timings_.mesh_ms = MsSince(start);
+  return s;
+}
+
+Status Warper::ComputeLayeredMesh(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+                                  const Eigen::Quaterniond& R_b, const Eigen::Vector2d& t_b,
+                                  const RowRotations& rows, const SubjectRegion& region,
+                                  double dt) {
+  if (blend_ == nullptr) return Status::Error("warp: layered mesh needs warp.mode layered");
+  const auto start = std::chrono::steady_clock::now();
+  Status s = MeshForPose(R_b, t_b, rows, &background_source_, &mesh_.source_row);
+  if (!s.ok()) return s;
+  s = MeshForPose(R_v, t, rows, &subject_source_, &row_scratch_);
+  if (!s.ok()) return s;
+  const CameraIntrinsics& k = model_.intrinsics();
+  blend_->Blend(subject_source_, background_source_, region, dt, k.width, k.height, &mesh_.source,
+                &blend_report_);
   timings_.mesh_ms = MsSince(start);
   return Status::Ok();
 }

@@ -456,3 +456,52 @@ TEST(PipelinePresetTest, EveryPresetHasNoUndefinedPixels) {
 
 }  // namespace
 }  // namespace steadiface
+
+namespace steadiface {
+namespace {
+
+// The vlog preset: a head with neck and shoulders at arm's length. The
+// subject mask (SubjectCovers) holds the face and the torso below it, not
+// the background beside them, and the torso moves with the head.
+TEST(SimulatorTest, VlogHasATorsoUnderTheFaceAndASubjectMask) {
+  auto s = Make("vlog");
+  ASSERT_TRUE(s->options().render_torso);
+  for (int i : {0, 45}) {
+    const sim::SimTruth t = s->Truth(i);
+    ASSERT_TRUE(t.head_in_view);
+    const double w = t.face_scale_px;
+    EXPECT_TRUE(s->SubjectCovers(i, t.head_px));
+    // Shoulders: 1.2 face widths below and 0.6 to the side of the face's
+    // centre (outside the face billboard's ellipse).
+    EXPECT_TRUE(s->SubjectCovers(i, t.head_px + Eigen::Vector2d(0.6 * w, 1.2 * w)));
+    EXPECT_TRUE(s->SubjectCovers(i, t.head_px + Eigen::Vector2d(-0.6 * w, 1.2 * w)));
+    // Background beside the head and above the shoulders.
+    EXPECT_FALSE(s->SubjectCovers(i, t.head_px + Eigen::Vector2d(1.4 * w, -0.3 * w)));
+    EXPECT_FALSE(s->SubjectCovers(i, Eigen::Vector2d(5, 5)));
+  }
+  // The walk preset has no torso: below the face is background.
+  auto walk = Make("walk");
+  const sim::SimTruth t = walk->Truth(0);
+  EXPECT_FALSE(walk->SubjectCovers(0, t.head_px + Eigen::Vector2d(0.6 * t.face_scale_px,
+                                                                    1.2 * t.face_scale_px)));
+  // The rendered torso is there: the pixels under the shoulders' point
+  // differ from a render without it.
+  sim::SimulatorOptions no_torso = s->options();
+  no_torso.render_torso = false;
+  std::unique_ptr<sim::Simulator> bare;
+  ASSERT_TRUE(sim::Simulator::Create(no_torso, &bare).ok());
+  cv::Mat a, b;
+  sim::SimTruth ta, tb;
+  ASSERT_TRUE(s->Render(0, &a, &ta).ok());
+  ASSERT_TRUE(bare->Render(0, &b, &tb).ok());
+  const Eigen::Vector2d p =
+      ta.head_px + Eigen::Vector2d(0.6 * ta.face_scale_px, 1.2 * ta.face_scale_px);
+  if (p.y() < a.rows - 1) {
+    const cv::Vec3b ca = a.at<cv::Vec3b>(static_cast<int>(p.y()), static_cast<int>(p.x()));
+    const cv::Vec3b cb = b.at<cv::Vec3b>(static_cast<int>(p.y()), static_cast<int>(p.x()));
+    EXPECT_NE(ca, cb);
+  }
+}
+
+}  // namespace
+}  // namespace steadiface

@@ -42,9 +42,11 @@ std::vector<std::string> Split(const std::string& s) {
 
 int Usage() {
   std::cerr << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
-               "       [--methods none,gyro-only,steadiface,none/video,\n"
+               "       [--methods none,gyro-only,steadiface,steadiface-layered,none/video,\n"
                "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
-               "       [--size WxH] [--seed N] [--render] [--crop R]\n";
+               "       [--size WxH] [--seed N] [--render] [--crop R]\n"
+               "       [--band W] [--band-inside F] [--max-offset C] [--offset-lowpass HZ]\n"
+               "         (the layered warp's warp/layered/* options, for sweeps)\n";
   return 2;
 }
 
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   bool render = false;
   double crop = NAN;  // NaN: the package default
+  steadiface::LayerBlendOptions blend;  // --band etc.
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -74,6 +77,10 @@ int main(int argc, char** argv) {
     else if (a == "--seed") seed = std::strtoull(next().c_str(), nullptr, 10);
     else if (a == "--render") render = true;
     else if (a == "--crop") crop = std::atof(next().c_str());
+    else if (a == "--band") blend.band_width = std::atof(next().c_str());
+    else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
+    else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
+    else if (a == "--offset-lowpass") blend.offset_lowpass_hz = std::atof(next().c_str());
     else if (a == "--size") {
       if (std::sscanf(next().c_str(), "%dx%d", &width, &height) != 2) return Usage();
     } else {
@@ -95,7 +102,8 @@ int main(int argc, char** argv) {
     }
   }
   for (const std::string& name : methods) {
-    if (name != "none" && name != "gyro-only" && name != "steadiface" && name != "none/video" &&
+    if (name != "none" && name != "gyro-only" && name != "steadiface" &&
+        name != "steadiface-layered" && name != "steadiface-layered/video" && name != "none/video" &&
         name != "steadiface/video" && name != "gyro-only/video" && name != "ffmpeg-vidstab" &&
         name != "ffmpeg-deshake") {
       std::cerr << "unknown method " << name << "\n";
@@ -119,8 +127,9 @@ int main(int argc, char** argv) {
   std::cout << "| preset | method | head jitter px | head jitter %diag | background jitter px"
                " | head-vs-bg jitter px | bg floor px"
                " | head stability | bg stability | cropping | distortion | undefined frames |"
-               " solver p50 ms | face p50 ms | scoring |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+               " solver p50 ms | face p50 ms | visible bg jitter px | line deviation px |"
+               " min cell ratio | band jitter px | scoring |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   bool first = true;
   int failures = 0;
   auto fmt = [](const char* f, double v) {
@@ -208,10 +217,13 @@ int main(int argc, char** argv) {
         for (size_t i = 0; s.ok() && i < frames.size(); ++i) s = vs->Add(frames[i]);
         if (s.ok()) peer_ms = 1000.0 * seconds / std::max<size_t>(1, frames.size());
       } else {
-        const Method m = base == "none" ? Method::kNone
-                         : base == "gyro-only" ? Method::kGyroOnly : Method::kSteadiface;
+        const Method m = base == "none"                 ? Method::kNone
+                         : base == "gyro-only"          ? Method::kGyroOnly
+                         : base == "steadiface-layered" ? Method::kSteadifaceLayered
+                                                        : Method::kSteadiface;
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
+        po.warp.layered.blend = blend;
         std::unique_ptr<steadiface::eval::Scorecard> card;
         s = steadiface::eval::MakeScorecard(*sim, po, &card);
         steadiface::eval::VideoScorer* vsp = vs.get();
@@ -275,7 +287,11 @@ int main(int argc, char** argv) {
                 << fmt("%.2f", sc.background_stability) << " | " << fmt("%.2f", sc.cropping)
                 << " | " << fmt("%.3f", sc.distortion) << " | "
                 << fmt("%.1f%%", 100 * sc.undefined_fraction) << " | " << fmt("%.3f", solver)
-                << " | " << fmt("%.2f", face) << " | " << scoring << " |" << std::endl;
+                << " | " << fmt("%.2f", face) << " | "
+                << fmt("%.2f", sc.visible_background_jitter_px) << " | "
+                << fmt("%.2f", sc.line_deviation_px) << " | " << fmt("%.3f", sc.min_cell_ratio)
+                << " | " << fmt("%.2f", sc.band_jitter_px) << " | " << scoring << " |"
+                << std::endl;
       json << (first ? "" : ",\n") << "    {\"preset\": \"" << preset
            << "\", \"duration_s\": " << so.duration_s << ", \"method\": \"" << name
            << "\", \"scoring\": \"" << scoring << "\", \"frames\": " << sc.frames
@@ -290,6 +306,13 @@ int main(int argc, char** argv) {
            << ", \"cropping\": " << jnum(sc.cropping) << ", \"distortion\": " << jnum(sc.distortion)
            << ", \"undefined_fraction\": " << jnum(sc.undefined_fraction)
            << ", \"face_fraction\": " << jnum(face_fraction)
+           << ", \"visible_background_jitter_px\": " << jnum(sc.visible_background_jitter_px)
+           << ", \"line_deviation_px\": " << jnum(sc.line_deviation_px)
+           << ", \"line_deviation_frame\": " << sc.line_deviation_frame
+           << ", \"min_cell_ratio\": " << jnum(sc.min_cell_ratio)
+           << ", \"p01_cell_ratio\": " << jnum(sc.p01_cell_ratio)
+           << ", \"folded_cells\": " << sc.folded_cells
+           << ", \"band_jitter_px\": " << jnum(sc.band_jitter_px)
            << ", \"peer_wall_ms_per_frame\": " << jnum(peer_ms) << ", \"stage_ms\": {";
       for (size_t k = 0; k < sc.stage_ms.size(); ++k) {
         json << (k ? ", " : "") << "\"" << sc.stage_ms[k].first << "\": ["

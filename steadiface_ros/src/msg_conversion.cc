@@ -379,6 +379,22 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   m.has_background_layer = f.background.valid;
   m.background_rotation = ToMsg(f.background.R_v);
   m.background_principal_offset = {f.background.t.x(), f.background.t.y()};
+  m.warp_mode = pf.layered.active ? "layered" : "global";
+  if (pf.layered.active) {
+    const steadiface::LayerBlendReport& b = pf.layered.blend;
+    m.layer_blend = pf.layered.region.blend;
+    m.layer_blend_step = pf.layered.region.blend_step;
+    m.band_px = b.band_px;
+    m.layer_offset_px = b.offset_px;
+    m.layer_offset_capped_px = b.capped_offset_px;
+    m.layer_shift_px = b.shift_px;
+    m.layer_keep = b.protrusion_keep;
+    m.min_cell_ratio = b.min_cell_ratio;
+    m.folded_cells = static_cast<uint32_t>(std::max(0, b.folded_cells));
+  } else {
+    m.layer_keep = 1.0;
+    m.min_cell_ratio = 1.0;
+  }
   const steadiface::GyroVideoCheckResult& c = pf.gyro_video_check;
   m.check_judged = c.judged;
   m.check_motion_px = c.motion_px;
@@ -397,7 +413,10 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
     if (!std::isfinite(v)) v = 0.0;
   };
   for (double* v : {&m.energy_fit, &m.energy_distortion, &m.energy_follow, &m.energy_rotation,
-                    &m.energy_translation, &m.energy_protrusion, &m.mean_angular_speed}) {
+                    &m.energy_translation, &m.energy_protrusion, &m.mean_angular_speed,
+                    &m.layer_blend, &m.layer_blend_step, &m.band_px, &m.layer_offset_px,
+                    &m.layer_offset_capped_px, &m.layer_shift_px, &m.layer_keep,
+                    &m.min_cell_ratio}) {
     clean(*v);
   }
   return m;

@@ -287,6 +287,29 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Int("warp/mesh_rows", &po->warp.mesh_rows, 1, 512);
   r.Int("warp/num_threads", &po->warp.num_threads, 0, 256);
   r.Bool("warp/fixed_point_maps", &po->warp.fixed_point_maps);
+  std::string mode = WarpModeName(po->warp.mode);
+  r.Str("warp/mode", &mode);
+  {
+    const Status ms = ParseWarpMode(mode, &po->warp.mode);
+    if (!ms.ok()) r.Error("parameter 'warp/mode': " + ms.message());
+  }
+  LayeredWarpOptions& lw = po->warp.layered;
+  r.Int("warp/layered/mesh_cols", &lw.mesh_cols, 2, 512);
+  r.Int("warp/layered/mesh_rows", &lw.mesh_rows, 2, 512);
+  r.Num("warp/layered/band_width", &lw.blend.band_width, 0.02, 10.0);
+  r.Num("warp/layered/band_inside", &lw.blend.band_inside, 0.0, 1.0);
+  r.Num("warp/layered/max_offset", &lw.blend.max_offset, 0.0, 10.0);
+  r.Num("warp/layered/offset_lowpass", &lw.blend.offset_lowpass_hz, 0.0, 10.0);
+  r.Num("warp/layered/band_data_weight", &lw.blend.band_data_weight, 1e-6, 1.0);
+  r.Num("warp/layered/shape_weight", &lw.blend.shape_weight, 0.0, 1e4);
+  r.Num("warp/layered/temporal_weight", &lw.blend.temporal_weight, 0.0, 1e4);
+  r.Num("warp/layered/head_width_scale", &lw.region.head_width_scale, 0.2, 5.0);
+  r.Num("warp/layered/head_top_scale", &lw.region.head_top_scale, 0.0, 3.0);
+  r.Bool("warp/layered/torso", &lw.region.torso);
+  r.Num("warp/layered/shoulder_width_scale", &lw.region.shoulder_width_scale, 0.2, 10.0);
+  r.Num("warp/layered/neck_width_scale", &lw.region.neck_width_scale, 0.05, 5.0);
+  r.Num("warp/layered/region_smoothing", &lw.region.smoothing_s, 0.0, 10.0);
+  r.Num("warp/layered/ramp", &lw.region.ramp_s, 0.01, 60.0);
   // The gyro-vs-video check.
   GyroVideoCheckOptions& c = po->gyro_video_check;
   r.Bool("gyro_video_check/enabled", &c.enabled);
@@ -345,7 +368,18 @@ void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::StabilizerOp
   o->smooth_head_in_virtual_view = c.smooth_head_in_virtual_view;
 }
 
-steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptions& o) {
+void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::WarpMode* mode,
+                 steadiface::LayeredWarpOptions* layered) {
+  steadiface::WarpMode m;
+  if (steadiface::ParseWarpMode(c.warp_mode, &m).ok()) *mode = m;
+  layered->blend.band_width = c.band_width;
+  layered->blend.band_inside = c.band_inside;
+  layered->blend.max_offset = c.max_offset;
+  layered->blend.offset_lowpass_hz = c.offset_lowpass;
+}
+
+steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptions& o,
+                                               const steadiface::WarpOptions& w) {
   steadiface::SteadifaceConfig c = steadiface::SteadifaceConfig::__getDefault__();
   c.w_fit = o.weights.fit;
   c.w_distortion = o.weights.distortion;
@@ -382,6 +416,11 @@ steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptio
   c.protrusion_search_steps = o.protrusion_search_steps;
   c.solver_max_iterations = o.solver.max_iterations;
   c.smooth_head_in_virtual_view = o.smooth_head_in_virtual_view;
+  c.warp_mode = steadiface::WarpModeName(w.mode);
+  c.band_width = w.layered.blend.band_width;
+  c.band_inside = w.layered.blend.band_inside;
+  c.max_offset = w.layered.blend.max_offset;
+  c.offset_lowpass = w.layered.blend.offset_lowpass_hz;
   return c;
 }
 

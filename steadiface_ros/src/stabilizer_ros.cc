@@ -43,7 +43,7 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
       new dynamic_reconfigure::Server<steadiface::SteadifaceConfig>(reconfigure_mutex_, pnh_));
   {
     boost::recursive_mutex::scoped_lock lock(reconfigure_mutex_);
-    reconfigure_->updateConfig(ConfigFromOptions(pipeline_options_.stabilizer));
+    reconfigure_->updateConfig(ConfigFromOptions(pipeline_options_.stabilizer, pipeline_options_.warp));
   }
   reconfigure_->setCallback(
       [this](steadiface::SteadifaceConfig& c, uint32_t level) { OnReconfigure(c, level); });
@@ -203,6 +203,10 @@ void StabilizerRos::OnReconfigure(steadiface::SteadifaceConfig& config, uint32_t
   steadiface::StabilizerOptions o = wrapper_->pipeline_options().stabilizer;
   ApplyConfig(config, &o);
   wrapper_->RequestStabilizerOptions(o);
+  steadiface::WarpMode mode = wrapper_->pipeline_options().warp.mode;
+  steadiface::LayeredWarpOptions layered = wrapper_->pipeline_options().warp.layered;
+  ApplyConfig(config, &mode, &layered);
+  wrapper_->RequestLayering(mode, layered);
 }
 
 bool StabilizerRos::LookupExtrinsic(const std::string& imu_frame,

@@ -45,20 +45,48 @@ void StabilizerWrapper::RequestStabilizerOptions(const steadiface::StabilizerOpt
   options_pending_ = true;
 }
 
+void StabilizerWrapper::RequestLayering(steadiface::WarpMode mode,
+                                        const steadiface::LayeredWarpOptions& layered) {
+  std::lock_guard<std::mutex> lock(options_mutex_);
+  requested_mode_ = mode;
+  requested_layered_ = layered;
+  layering_pending_ = true;
+}
+
 void StabilizerWrapper::ApplyPendingOptions() {
   steadiface::StabilizerOptions o;
+  bool layering = false, stabilizer = false;
+  steadiface::WarpMode mode;
+  steadiface::LayeredWarpOptions layered;
   {
     std::lock_guard<std::mutex> lock(options_mutex_);
-    if (!options_pending_) return;
+    stabilizer = options_pending_;
+    layering = layering_pending_;
     o = requested_options_;
-    options_pending_ = false;
+    mode = requested_mode_;
+    layered = requested_layered_;
+    options_pending_ = layering_pending_ = false;
   }
+  if (layering && !steadiface::SameLayering(mode, layered, options_.warp)) {
+    if (pipeline_) {
+      const steadiface::Status s = pipeline_->UpdateLayering(mode, layered);
+      if (!s.ok()) {
+        sink_->Error("reconfigure", "reconfigure rejected: " + s.message());
+        return;
+      }
+      options_.stabilizer.background_layer = pipeline_->options().stabilizer.background_layer;
+    }
+    options_.warp.mode = mode;
+    options_.warp.layered = layered;
+  }
+  if (!stabilizer) return;
   if (pipeline_) {
     const steadiface::Status s = pipeline_->UpdateStabilizerOptions(o);
     if (!s.ok()) {
       sink_->Error("reconfigure", "reconfigure rejected: " + s.message());
       return;
     }
+    o = pipeline_->options().stabilizer;  // layered mode keeps its background layer
   }
   options_.stabilizer = o;
 }
@@ -395,6 +423,11 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
       steadiface::DrawDebugOverlay(input, pipeline_->camera_model(),
                                    pipeline_->stabilizer().protrusion(), &frame.face,
                                    &frame.stabilizer, &dbg);
+      if (frame.layered.active) {
+        const steadiface::OutputGeometry& og = pipeline_->warper().output_geometry();
+        steadiface::DrawLayeredOverlay(pipeline_->warper().mesh(), frame.layered.region,
+                                       frame.layered.blend, og.width(), og.height(), &dbg);
+      }
       sink_->PublishDebugImage(
           cv_bridge::CvImage(in_header, sensor_msgs::image_encodings::BGR8, dbg).toImageMsg());
     }

@@ -69,7 +69,8 @@ TEST(ParamsTest, DefaultYamlStatesTheCoreDefaults) {
 TEST(ParamsTest, ReconfigureDefaultsAreTheCoreDefaults) {
   dynamic_reconfigure::Config from_cfg, from_core;
   steadiface::SteadifaceConfig::__getDefault__().__toMessage__(from_cfg);
-  ConfigFromOptions(steadiface::StabilizerOptions()).__toMessage__(from_core);
+  ConfigFromOptions(steadiface::StabilizerOptions(), steadiface::WarpOptions())
+      .__toMessage__(from_core);
   ASSERT_EQ(from_cfg.doubles.size(), from_core.doubles.size());
   ASSERT_GT(from_cfg.doubles.size(), 10u);
   for (size_t i = 0; i < from_cfg.doubles.size(); ++i) {
@@ -85,6 +86,24 @@ TEST(ParamsTest, ReconfigureDefaultsAreTheCoreDefaults) {
   for (size_t i = 0; i < from_cfg.bools.size(); ++i) {
     EXPECT_EQ(from_cfg.bools[i].value, from_core.bools[i].value) << from_cfg.bools[i].name;
   }
+  ASSERT_EQ(from_cfg.strs.size(), from_core.strs.size());
+  for (size_t i = 0; i < from_cfg.strs.size(); ++i) {
+    EXPECT_EQ(from_cfg.strs[i].value, from_core.strs[i].value) << from_cfg.strs[i].name;
+  }
+}
+
+TEST(ParamsTest, ReconfigureSwitchesTheWarpMode) {
+  steadiface::SteadifaceConfig c = steadiface::SteadifaceConfig::__getDefault__();
+  c.warp_mode = "layered";
+  c.band_width = 0.8;
+  steadiface::WarpMode mode = steadiface::WarpMode::kGlobal;
+  steadiface::LayeredWarpOptions layered;
+  ApplyConfig(c, &mode, &layered);
+  EXPECT_EQ(mode, steadiface::WarpMode::kLayered);
+  EXPECT_DOUBLE_EQ(layered.blend.band_width, 0.8);
+  c.warp_mode = "sideways";  // not a mode: left as it was
+  ApplyConfig(c, &mode, &layered);
+  EXPECT_EQ(mode, steadiface::WarpMode::kLayered);
 }
 
 TEST(ParamsTest, AnOutOfRangeValueNamesItsKey) {

@@ -191,6 +191,61 @@ TEST(WrapperTest, BackgroundLayerIsPublishedAsItsOwnFrameWhenOn) {
   ExpectAllFinite(on_sink);
 }
 
+// warp/mode layered: both virtual cameras in TF, the mode and the blend's
+// figures in `state`, a full-size output, the debug image with the region
+// drawn, and camera_info for the background layer (most of the frame). A
+// reconfigure back to global takes effect from the next frame.
+TEST(WrapperTest, LayeredModePublishesBothLayersAndSwitchesBackToGlobal) {
+  struct DebugSink : public Sink {
+    std::vector<sensor_msgs::ImagePtr> debug;
+    bool WantsDebugImage() const override { return true; }
+    void PublishDebugImage(const sensor_msgs::ImagePtr& i) override { debug.push_back(i); }
+  };
+  DebugSink sink;
+  steadiface::PipelineOptions po = Options();
+  po.landmark_source = steadiface::LandmarkSource::kDlib;  // the region needs a face
+  po.warp.mode = steadiface::WarpMode::kLayered;
+  StabilizerWrapper w(po, WrapperOptions(), &sink);
+  const int n = static_cast<int>(TestStream().images.size());
+  Feed(&w, TestStream(), 0, n / 2);
+  Sink gyro_sink;
+  steadiface::PipelineOptions go = Options();
+  go.stabilizer.gyro_only = true;
+  go.landmark_source = steadiface::LandmarkSource::kNone;
+  StabilizerWrapper gyro(go, WrapperOptions(), &gyro_sink);
+  Feed(&gyro, TestStream(), 0, n / 2);
+  ASSERT_EQ(sink.states.size(), static_cast<size_t>(n / 2));
+  size_t background_tf = 0;
+  for (const auto& t : sink.tf) background_tf += t.child_frame_id == "cam_stabilized_background";
+  EXPECT_EQ(background_tf, sink.states.size());
+  bool blended = false;
+  for (size_t i = 0; i < sink.states.size(); ++i) {
+    const auto& st = sink.states[i];
+    EXPECT_EQ(st.warp_mode, "layered");
+    ASSERT_TRUE(st.has_background_layer);
+    EXPECT_EQ(st.folded_cells, 0u);
+    EXPECT_GE(st.min_cell_ratio, 0.5);
+    EXPECT_GE(st.layer_blend, 0.0);
+    EXPECT_LE(st.layer_blend, 1.0);
+    blended = blended || st.layer_blend > 0.5;
+    // The output's intrinsics are the background layer's: a gyro-only run's.
+    ASSERT_LT(i, gyro_sink.infos.size());
+    EXPECT_EQ(sink.infos[i]->K[2], gyro_sink.infos[i]->K[2]);
+    EXPECT_EQ(sink.infos[i]->K[5], gyro_sink.infos[i]->K[5]);
+    EXPECT_EQ(sink.images[i]->width, TestStream().images[0]->width);
+  }
+  EXPECT_TRUE(blended);  // the face was found and the region applied
+  ASSERT_FALSE(sink.debug.empty());
+  ExpectAllFinite(sink);
+  // Back to global at run time.
+  w.RequestLayering(steadiface::WarpMode::kGlobal, steadiface::LayeredWarpOptions());
+  Feed(&w, TestStream(), n / 2, n);
+  ASSERT_EQ(sink.states.size(), static_cast<size_t>(n));
+  EXPECT_EQ(sink.states.back().warp_mode, "global");
+  EXPECT_EQ(w.pipeline_options().warp.mode, steadiface::WarpMode::kGlobal);
+  EXPECT_EQ(sink.errors.count("reconfigure"), 0u);
+}
+
 // Latency parts in `state` on the sink's clock: image arrival, waiting for
 // the gyro to cover the last row, publication (the test's clock does not
 // advance during processing). Offline (no clock) they stay 0.

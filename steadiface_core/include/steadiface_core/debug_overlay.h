@@ -1,5 +1,7 @@
 #pragma once
 
+#include "steadiface_core/warper.h"
+
 #include <opencv2/core.hpp>
 
 #include "steadiface_core/camera_model.h"
@@ -20,5 +22,13 @@ void DrawDebugOverlay(const cv::Mat& input, const CameraModel& model,
                       const ProtrusionGeometry& protrusion,
                       const FaceInfo* face, const StabilizerFrame* frame,
                       cv::Mat* out);
+
+/// Layered warp: draws onto the debug image (input coordinates) the subject
+/// region's outline (orange) and the band's inner and outer edges (blue),
+/// each traced in the output and mapped into the input through the final
+/// mesh, and a text line with the blend, the offsets and the worst cell.
+void DrawLayeredOverlay(const WarpMesh& mesh, const SubjectRegion& region,
+                        const LayerBlendReport& blend, int output_width, int output_height,
+                        cv::Mat* out);
 
 }  // namespace steadiface

@@ -58,6 +58,15 @@ struct PipelineTimings {
   double total_ms = 0.0;
 };
 
+/// The layered warp's view of one frame (warp mode layered).
+struct LayeredFrame {
+  bool active = false;  ///< warp mode is layered
+  /// The subject region (output px) and its blend weight.
+  SubjectRegion region;
+  /// What the mesh optimization did (offsets, distortion, timing).
+  LayerBlendReport blend;
+};
+
 /// One processed frame.
 struct PipelineFrame {
   FaceInfo face;
@@ -70,6 +79,8 @@ struct PipelineFrame {
   PipelineTimings timings;
   /// The gyro-vs-video check over its window (GyroVideoCheck).
   GyroVideoCheckResult gyro_video_check;
+  /// The layered warp (warp mode layered).
+  LayeredFrame layered;
 };
 
 /// The whole per-frame chain for one camera + IMU stream: gyro timeline,
@@ -106,6 +117,11 @@ class Pipeline {
   /// Replaces the stabilizer's tunable options from the next frame on.
   Status UpdateStabilizerOptions(const StabilizerOptions& options);
 
+  /// Replaces the warp mode and the layered warp's options from the next
+  /// frame on (rebuilds the warper; switching to layered starts the
+  /// background layer's trajectory). Validated; on error nothing changes.
+  Status UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered);
+
   /// Time jumped back: forget gyro, face lock and trajectory.
   void Reset();
 
@@ -127,6 +143,9 @@ class Pipeline {
   std::unique_ptr<Stabilizer> stabilizer_;
   std::unique_ptr<Warper> warper_;
   std::unique_ptr<GyroVideoCheck> check_;  // null when disabled
+  std::unique_ptr<SubjectRegionTracker> region_;  // layered mode
+  bool has_last_stamp_ = false;
+  Time last_stamp_;
 };
 
 }  // namespace steadiface

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -8,6 +9,8 @@
 #include <opencv2/core.hpp>
 
 #include "steadiface_core/camera_model.h"
+#include "steadiface_core/layered/layer_blend.h"
+#include "steadiface_core/layered/subject_region.h"
 #include "steadiface_core/output_geometry.h"
 #include "steadiface_core/protrusion.h"
 #include "steadiface_core/row_rotations.h"
@@ -15,8 +18,40 @@
 
 namespace steadiface {
 
+/// How the output is composed from the virtual cameras.
+enum class WarpMode {
+  /// One virtual camera for the whole frame (the paper's): the subject
+  /// layer's pose.
+  kGlobal,
+  /// Two layers (issue 15): inside the subject region the mesh follows the
+  /// face-following (subject) layer, outside it the background layer (the
+  /// gyro-only pose), joined across a band by a per-frame mesh
+  /// optimization (LayerBlend).
+  kLayered,
+};
+
+/// Parses "global" / "layered".
+Status ParseWarpMode(const std::string& name, WarpMode* mode);
+const char* WarpModeName(WarpMode mode);
+
+/// Options of the layered warp.
+struct LayeredWarpOptions {
+  /// The subject region and its blend weight.
+  SubjectRegionOptions region;
+  /// The mesh optimization across the band.
+  LayerBlendOptions blend;
+  /// Mesh cells across / down in layered mode (denser than the global
+  /// mesh, so the band spans several cells) [count].
+  int mesh_cols = 32;
+  int mesh_rows = 18;
+};
+
 /// Options of the mesh warp (image composition).
 struct WarpOptions {
+  /// Global (one virtual camera) or layered (subject + background).
+  WarpMode mode = WarpMode::kGlobal;
+  /// Used in layered mode.
+  LayeredWarpOptions layered;
   /// Output crop and size.
   OutputOptions output;
   /// Mesh cells across the output width [count].
@@ -41,6 +76,9 @@ struct WarpOptions {
 };
 
 Status ValidateWarpOptions(const WarpOptions& options);
+
+/// True when `mode` and `layered` equal those of `options` (field by field).
+bool SameLayering(WarpMode mode, const LayeredWarpOptions& layered, const WarpOptions& options);
 
 /// The warp mesh: for a grid of output vertices, the raw input pixel each one
 /// samples.
@@ -78,6 +116,19 @@ class Warper {
   /// camera.
   Status ComputeMesh(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
                      const RowRotations& rows);
+  /// Layered mode: the subject layer's mesh (R_v, t), the background
+  /// layer's (R_b, t_b) and their join across the region's band
+  /// (LayerBlend); `dt` is the time since the last frame [s]. With no
+  /// region (or blend 0) the mesh is the background layer's. Needs mode ==
+  /// kLayered.
+  Status ComputeLayeredMesh(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+                            const Eigen::Quaterniond& R_b, const Eigen::Vector2d& t_b,
+                            const RowRotations& rows, const SubjectRegion& region,
+                            double dt);
+  /// Forgets the layered mesh's temporal state (time jumped).
+  void reset() {
+    if (blend_ != nullptr) blend_->reset();
+  }
   /// Dense maps from the last mesh.
   void BuildMaps();
   /// Remaps `input` (8-bit, 1-4 channels, the camera model's size) into
@@ -89,6 +140,12 @@ class Warper {
               cv::Mat* output);
 
   const WarpMesh& mesh() const { return mesh_; }
+  /// Layered mode: the two layers' meshes of the last ComputeLayeredMesh,
+  /// the blend's report and per-vertex blend weights.
+  const std::vector<Eigen::Vector2f>& subject_mesh() const { return subject_source_; }
+  const std::vector<Eigen::Vector2f>& background_mesh() const { return background_source_; }
+  const LayerBlendReport& blend_report() const { return blend_report_; }
+  const LayerBlend* layer_blend() const { return blend_.get(); }
   const WarpTimings& timings() const { return timings_; }
   const OutputGeometry& output_geometry() const { return output_; }
   const ProtrusionGeometry& protrusion() const { return protrusion_; }
@@ -105,7 +162,16 @@ class Warper {
   const WarpOptions options_;
   const OutputGeometry output_;
   const ProtrusionGeometry protrusion_;
+  // Fills `source`/`source_row` with one pose's mesh.
+  Status MeshForPose(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+                     const RowRotations& rows, std::vector<Eigen::Vector2f>* source,
+                     std::vector<float>* source_row) const;
+
   WarpMesh mesh_;
+  std::vector<Eigen::Vector2f> subject_source_, background_source_;
+  std::vector<float> row_scratch_;
+  std::unique_ptr<LayerBlend> blend_;  // layered mode
+  LayerBlendReport blend_report_;
   cv::Mat map1_, map2_;  // fixed point: CV_16SC2 + CV_16UC1; float: 2x 32FC1
   WarpTimings timings_;
 };

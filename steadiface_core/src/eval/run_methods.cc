@@ -11,6 +11,8 @@ const char* MethodName(Method m) {
       return "gyro-only";
     case Method::kSteadiface:
       return "steadiface";
+    case Method::kSteadifaceLayered:
+      return "steadiface-layered";
   }
   return "?";
 }
@@ -20,9 +22,10 @@ PipelineOptions OptionsFor(const sim::Simulator& sim, Method method) {
   o.shutter.readout_time_s = sim.options().readout_s;
   o.shutter.stamp = StampConvention::kFirstRow;
   o.imu.imu_time_offset_s = sim.options().imu_clock_offset_s;
-  o.landmark_source =
-      method == Method::kSteadiface ? LandmarkSource::kDlib : LandmarkSource::kNone;
-  o.stabilizer.gyro_only = method != Method::kSteadiface;
+  const bool face = method == Method::kSteadiface || method == Method::kSteadifaceLayered;
+  o.landmark_source = face ? LandmarkSource::kDlib : LandmarkSource::kNone;
+  o.stabilizer.gyro_only = !face;
+  if (method == Method::kSteadifaceLayered) o.warp.mode = WarpMode::kLayered;
   o.render_output = false;
   return o;
 }
@@ -77,7 +80,7 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
   for (int i = 0; i < sim.num_frames(); ++i) {
     const Time stamp = sim.Truth(i).stamp;
     FeedGyroForFrame(sim, stamp, o.imu.imu_time_offset_s, p.get(), &g);
-    if (method == Method::kSteadiface || render) {
+    if (o.landmark_source == LandmarkSource::kDlib || render) {
       s = sim.Render(i, &frame, &truth);
       if (!s.ok()) return s;
     } else {
@@ -92,9 +95,23 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
     w.R_v = out.stabilizer.R_v;
     w.t = out.stabilizer.t;
     w.rows = out.stabilizer.rows;
+    if (o.warp.mode == WarpMode::kLayered) {
+      // The joined mesh is the warp (the subject pose holds only inside the
+      // region).
+      const WarpMesh& m = p->warper().mesh();
+      w.kind = FrameWarp::Kind::kMesh;
+      w.mesh_u = m.u;
+      w.mesh_v = m.v;
+      w.mesh_source = m.source;
+      w.mesh_background = p->warper().background_mesh();
+      if (p->warper().layer_blend() != nullptr) {
+        w.mesh_blend = p->warper().layer_blend()->vertex_blend();
+      }
+    }
     w.stage_ms = {{"face", out.timings.face_ms},
                   {"stabilizer", out.timings.stabilizer_ms},
                   {"solver", out.stabilizer.solver.time_ms}};
+    if (o.warp.mode == WarpMode::kLayered) w.stage_ms.push_back({"mesh", out.timings.mesh_ms});
     if (render) {
       w.stage_ms.push_back({"warp", out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms});
     }

@@ -7,8 +7,10 @@
 #include <limits>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
 #include <opencv2/core.hpp>
 
+#include "steadiface_core/layered/layer_blend.h"
 #include "steadiface_core/so3.h"
 
 namespace steadiface {
@@ -39,6 +41,73 @@ std::vector<double> Power(const std::vector<double>& x) {
     p[k] = c[0] * c[0] + c[1] * c[1];
   }
   return p;
+}
+
+// Inverts a warp mesh (output vertices -> input px) at input pixel p: the
+// output pixel whose bilinear source is p. Cells whose source quad's box
+// holds p are tried by Newton; without one, the nearest cell's bilinear
+// map is extrapolated.
+bool InvertMesh(const FrameWarp& w, const Eigen::Vector2d& p, Eigen::Vector2d* out) {
+  const int cols = static_cast<int>(w.mesh_u.size()), rows = static_cast<int>(w.mesh_v.size());
+  if (cols < 2 || rows < 2 || w.mesh_source.size() != static_cast<size_t>(cols * rows)) return false;
+  auto src = [&](int i, int j) { return w.mesh_source[j * cols + i].cast<double>().eval(); };
+  auto newton = [&](int i, int j, bool clamp, Eigen::Vector2d* o) {
+    const Eigen::Vector2d A = src(i, j), B = src(i + 1, j), C = src(i + 1, j + 1), E = src(i, j + 1);
+    double a = 0.5, b = 0.5;
+    for (int it = 0; it < 12; ++it) {
+      const Eigen::Vector2d S = (1 - a) * (1 - b) * A + a * (1 - b) * B + (1 - a) * b * E + a * b * C;
+      Eigen::Matrix2d J;
+      J.col(0) = (1 - b) * (B - A) + b * (C - E);
+      J.col(1) = (1 - a) * (E - A) + a * (C - B);
+      if (std::abs(J.determinant()) < 1e-12) return false;
+      const Eigen::Vector2d step = J.inverse() * (p - S);
+      a += step.x();
+      b += step.y();
+      if (step.norm() < 1e-9) break;
+    }
+    const double tol = 1e-6;
+    if (clamp && (a < -tol || a > 1 + tol || b < -tol || b > 1 + tol)) return false;
+    const Eigen::Vector2d S = (1 - a) * (1 - b) * A + a * (1 - b) * B + (1 - a) * b * E + a * b * C;
+    if ((S - p).norm() > 1e-4) return false;
+    *o = Eigen::Vector2d(w.mesh_u[i] + a * (w.mesh_u[i + 1] - w.mesh_u[i]),
+                         w.mesh_v[j] + b * (w.mesh_v[j + 1] - w.mesh_v[j]));
+    return true;
+  };
+  double best = std::numeric_limits<double>::infinity();
+  int bi = 0, bj = 0;
+  for (int j = 0; j + 1 < rows; ++j) {
+    for (int i = 0; i + 1 < cols; ++i) {
+      const Eigen::Vector2d A = src(i, j), B = src(i + 1, j), C = src(i + 1, j + 1), E = src(i, j + 1);
+      const Eigen::Vector2d lo = A.cwiseMin(B).cwiseMin(C).cwiseMin(E);
+      const Eigen::Vector2d hi = A.cwiseMax(B).cwiseMax(C).cwiseMax(E);
+      if (p.x() >= lo.x() - 1e-6 && p.y() >= lo.y() - 1e-6 && p.x() <= hi.x() + 1e-6 &&
+          p.y() <= hi.y() + 1e-6 && newton(i, j, true, out)) {
+        return true;
+      }
+      const double d = (0.25 * (A + B + C + E) - p).squaredNorm();
+      if (d < best) {
+        best = d;
+        bi = i;
+        bj = j;
+      }
+    }
+  }
+  return newton(bi, bj, false, out);
+}
+
+// Largest distance of 2D points from their total-least-squares line.
+double LineDeviation(const std::vector<Eigen::Vector2d>& pts) {
+  if (pts.size() < 3) return 0.0;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& q : pts) mean += q;
+  mean /= static_cast<double>(pts.size());
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const auto& q : pts) cov += (q - mean) * (q - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
+  const Eigen::Vector2d normal = es.eigenvectors().col(0);  // smallest eigenvalue
+  double worst = 0.0;
+  for (const auto& q : pts) worst = std::max(worst, std::abs(normal.dot(q - mean)));
+  return worst;
 }
 
 }  // namespace
@@ -109,6 +178,29 @@ Scorecard::Scorecard(const sim::Simulator& sim, const CameraModel& model,
     }
   }
   background_out_.resize(background_dirs_.size());
+  // The visible-background grid, denser and within the output crop.
+  for (double f : {0.1, 0.5, 0.9}) {
+    const Eigen::Quaterniond R = sim.CameraPose(f * T).R;
+    for (int yi = 0; yi < 5; ++yi) {
+      for (int xi = 0; xi < 9; ++xi) {
+        visible_dirs_.push_back(R * Eigen::Vector3d(-0.4 + 0.1 * xi, -0.22 + 0.11 * yi, 1.0));
+      }
+    }
+  }
+  visible_out_.resize(visible_dirs_.size());
+  // Straight world lines (great circles) seen from the middle of the
+  // sequence: three horizontal, four vertical.
+  const Eigen::Quaterniond Rm = sim.CameraPose(0.5 * T).R;
+  for (double y : {-0.15, 0.0, 0.15}) {
+    std::vector<Eigen::Vector3d> line;
+    for (int k = 0; k <= 60; ++k) line.push_back(Rm * Eigen::Vector3d(-0.6 + 0.02 * k, y, 1.0));
+    lines_.push_back(line);
+  }
+  for (double x : {-0.3, -0.15, 0.15, 0.3}) {
+    std::vector<Eigen::Vector3d> line;
+    for (int k = 0; k <= 40; ++k) line.push_back(Rm * Eigen::Vector3d(x, -0.4 + 0.02 * k, 1.0));
+    lines_.push_back(line);
+  }
 }
 
 bool Scorecard::MapToOutput(const FrameWarp& w, const Eigen::Vector2d& p,
@@ -123,6 +215,8 @@ bool Scorecard::MapToOutput(const FrameWarp& w, const Eigen::Vector2d& p,
       *out = q.hnormalized();
       return true;
     }
+    case FrameWarp::Kind::kMesh:
+      return InvertMesh(w, p, out);
     case FrameWarp::Kind::kPose: {
       Eigen::Vector2d V;
       if (!model_.Project(model_.PixelToNormalized(p), w.R_v, w.t, w.rows.At(p.y()), &V)) {
@@ -155,6 +249,69 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     if (k == 13) s.background_out = o;  // centre of the middle view
   }
   if (w.kind != FrameWarp::Kind::kIdentity) identity_ = false;
+  // Visible background and straight lines: input pixels the subject does
+  // not cover, landing inside the output image.
+  const double ow = w.kind == FrameWarp::Kind::kIdentity ? ki.width : output_.width();
+  const double oh = w.kind == FrameWarp::Kind::kIdentity ? ki.height : output_.height();
+  auto visible_out = [&](const Eigen::Vector3d& d, Eigen::Vector2d* o) {
+    Eigen::Vector2d px;
+    return sim_.BackgroundPixel(index, d, &px) && px.x() >= 0 && px.y() >= 0 &&
+           px.x() <= ki.width - 1 && px.y() <= ki.height - 1 && !sim_.SubjectCovers(index, px) &&
+           MapToOutput(w, px, o) && o->x() >= 0 && o->y() >= 0 && o->x() <= ow - 1 &&
+           o->y() <= oh - 1;
+  };
+  for (size_t k = 0; k < visible_dirs_.size(); ++k) {
+    Eigen::Vector2d o;
+    if (!visible_out(visible_dirs_[k], &o)) o = Eigen::Vector2d::Constant(NAN);
+    visible_out_[k].push_back(o);
+  }
+  for (const auto& line : lines_) {
+    std::vector<Eigen::Vector2d> run;
+    auto flush = [&] {
+      if (run.size() >= 5) {
+        const double dev = LineDeviation(run);
+        if (dev > line_dev_) {
+          line_dev_ = dev;
+          line_dev_frame_ = index;
+        }
+      }
+      run.clear();
+    };
+    for (const auto& d : line) {
+      Eigen::Vector2d o;
+      if (visible_out(d, &o)) {
+        run.push_back(o);
+      } else {
+        flush();
+      }
+    }
+    flush();
+  }
+  if (w.kind == FrameWarp::Kind::kMesh) {
+    const int cols = static_cast<int>(w.mesh_u.size()), rows = static_cast<int>(w.mesh_v.size());
+    std::vector<double> ratios;
+    folded_ += CellRatios(cols, rows, w.mesh_u, w.mesh_v, w.mesh_source, nullptr, &ratios);
+    cell_ratios_.insert(cell_ratios_.end(), ratios.begin(), ratios.end());
+    const size_t n = w.mesh_source.size();
+    if (w.mesh_background.size() == n && w.mesh_blend.size() == n) {
+      // Output px per input px, from the background mesh's middle row.
+      const int j = rows / 2;
+      double sum = 0.0, span = 0.0;
+      for (int i = 0; i + 1 < cols; ++i) {
+        sum += (w.mesh_background[j * cols + i + 1] - w.mesh_background[j * cols + i])
+                   .cast<double>().norm();
+        span += w.mesh_u[i + 1] - w.mesh_u[i];
+      }
+      const double zoom = sum > 0 ? span / sum : 1.0;
+      const double g = *std::max_element(w.mesh_blend.begin(), w.mesh_blend.end());
+      band_offsets_.resize(n);
+      band_frames_.resize(n, 0);
+      for (size_t k = 0; k < n; ++k) {
+        band_offsets_[k].push_back(zoom * (w.mesh_source[k] - w.mesh_background[k]).cast<double>());
+        if (w.mesh_blend[k] > 0.0 && w.mesh_blend[k] < 0.999 * g) ++band_frames_[k];
+      }
+    }
+  }
   // Distortion: local linear part at the output centre, via the input point
   // that lands there (numerically).
   double ratio = 1.0;
@@ -177,6 +334,15 @@ void Scorecard::Add(int index, const FrameWarp& w) {
   distortion_.push_back(ratio);
   // Undefined output pixels.
   bool undefined = false;
+  if (w.kind == FrameWarp::Kind::kMesh) {
+    // Bilinear cells: every pixel is defined when every vertex lands inside
+    // the input frame.
+    for (const auto& q : w.mesh_source) {
+      if (!(q.x() >= 0 && q.y() >= 0 && q.x() <= ki.width - 1 && q.y() <= ki.height - 1)) {
+        undefined = true;
+      }
+    }
+  }
   if (w.kind == FrameWarp::Kind::kPose) {
     undefined = !protrusion_.Check(w.R_v, w.t, w.rows, 0.0).defined;
     const Eigen::Vector3d v = LogSO3(w.R_v), r = LogSO3(w.rows.Middle());
@@ -264,6 +430,30 @@ Score Scorecard::Compute() const {
   sc.background_floor_px = nrel ? floor_sum / nrel : NAN;
   sc.background_jitter_frac = sc.background_jitter_px / diag;
   sc.background_stability = nbg ? bg_stab / nbg : NAN;
+  double vis = 0.0;
+  int nvis = 0;
+  for (const auto& traj : visible_out_) {
+    const std::vector<Eigen::Vector2d> r = LongestFiniteRun(traj);
+    if (r.size() < min_run) continue;
+    vis += HighPassRms(r, fps, options_.highpass_hz);
+    ++nvis;
+  }
+  sc.visible_background_jitter_px = nvis ? vis / nvis : NAN;
+  sc.line_deviation_px = line_dev_;
+  sc.line_deviation_frame = line_dev_frame_;
+  if (!cell_ratios_.empty()) {
+    sc.min_cell_ratio = *std::min_element(cell_ratios_.begin(), cell_ratios_.end());
+    sc.p01_cell_ratio = Percentile(cell_ratios_, 0.01);
+  }
+  sc.folded_cells = folded_;
+  double band = 0.0;
+  int nband = 0;
+  for (size_t k = 0; k < band_offsets_.size(); ++k) {
+    if (2 * band_frames_[k] < static_cast<int>(band_offsets_[k].size())) continue;
+    band += HighPassRms(band_offsets_[k], fps, options_.highpass_hz);
+    ++nband;
+  }
+  sc.band_jitter_px = nband ? band / nband : NAN;
   sc.cropping = pose ? std::pow(1.0 - 2.0 * output_.crop_ratio(), 2.0) : 1.0;
   sc.distortion = *std::min_element(distortion_.begin(), distortion_.end());
   sc.undefined_fraction = static_cast<double>(undefined_) / sc.frames;

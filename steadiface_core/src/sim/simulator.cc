@@ -30,7 +30,7 @@ bool Active(double t, double start, double end) {
 
 const std::vector<std::string>& PresetNames() {
   static const std::vector<std::string> names = {
-      "still", "walk", "pan", "run", "occlusion", "two_faces", "turn_away"};
+      "still", "walk", "pan", "run", "occlusion", "two_faces", "turn_away", "vlog"};
   return names;
 }
 
@@ -70,6 +70,10 @@ Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
     walk();
     o->second_face_start_s = 0.25 * o->duration_s;
     o->second_face_final_distance_m = 0.4;
+  } else if (name == "vlog") {
+    walk();
+    o->render_torso = true;
+    o->head.distance_m = 0.7;
   } else if (name == "turn_away") {
     walk();
     o->head.yaw_amplitude_rad = 1.2;
@@ -162,6 +166,42 @@ Status Simulator::Init() {
     }
     return P;
   };
+  {
+    // Neck and shoulders: a striped shirt, its top edge at the neck, 8 cm
+    // below the face's landmark centre; 2 mm per texel.
+    const double m = 0.002, width = o.torso_width_m, height = 0.5;
+    const int tw = static_cast<int>(width / m), th = static_cast<int>(height / m);
+    torso_.bgra = cv::Mat(th, tw, CV_8UC4);
+    for (int y = 0; y < th; ++y) {
+      cv::Vec4b* row = torso_.bgra.ptr<cv::Vec4b>(y);
+      for (int x = 0; x < tw; ++x) {
+        const double X = (x - 0.5 * (tw - 1)) * m, Y = y * m;
+        // Neck 12 cm wide, widening to the shoulders from 7 to 15 cm down.
+        const double s = std::min(1.0, std::max(0.0, (Y - 0.07) / 0.08));
+        const double half = 0.06 + (0.5 * width - 0.06) * s * s * (3 - 2 * s);
+        const double edge = (half - std::abs(X)) / m;  // texels inside
+        const double a = std::min(1.0, std::max(0.0, 0.5 + 0.5 * edge));
+        const bool neck = Y < 0.09;
+        const bool stripe = (x / 12) % 2 == 0;
+        row[x] = neck ? cv::Vec4b(120, 150, 200, 0) : stripe ? cv::Vec4b(150, 70, 40, 0)
+                                                            : cv::Vec4b(200, 190, 180, 0);
+        row[x][3] = static_cast<uchar>(std::lround(255.0 * a));
+      }
+    }
+    torso_.metres_per_px = m;
+    torso_.anchor_px = Eigen::Vector2d(0.5 * (tw - 1), 0.0);
+    torso_.pose = [this](double t) {
+      Pose P = face_.pose(t);
+      // The face billboard's position without its turning and nodding.
+      const Eigen::Vector3d centre = P.p + P.R * Eigen::Vector3d(
+          (face_centre_uv_.x() - face_.anchor_px.x()) * face_.metres_per_px,
+          (face_centre_uv_.y() - face_.anchor_px.y()) * face_.metres_per_px, 0.0);
+      Pose T;
+      T.R = Orbit(Pose(), t).R;
+      T.p = centre + T.R * Eigen::Vector3d(0.0, 0.08, options_.torso_depth_m);
+      return T;
+    };
+  }
   cv::Mat mirrored;
   cv::flip(photo, mirrored, 1);
   cv::Rect mr = o.face_region;
@@ -325,6 +365,7 @@ Status Simulator::Render(int i, cv::Mat* bgr, SimTruth* truth) const {
   const double t = ToSeconds(stamp);
   std::vector<const Billboard*> boards;
   if (Active(t, options_.second_face_start_s, -1)) boards.push_back(&second_face_);
+  if (options_.render_face && options_.render_torso) boards.push_back(&torso_);
   if (options_.render_face) boards.push_back(&face_);
   if (Active(t, options_.occlusion_start_s, options_.occlusion_end_s)) {
     boards.push_back(&occluder_);
@@ -339,6 +380,29 @@ Status Simulator::Render(int i, cv::Mat* bgr, SimTruth* truth) const {
     if (g != 1.0) bgr->convertTo(*bgr, -1, g, 0.0);
   }
   return Status::Ok();
+}
+
+bool Simulator::SubjectCovers(int i, const Eigen::Vector2d& px) const {
+  if (!options_.render_face) return false;
+  const double t = RowTimeS(Stamp(i), std::min(std::max(px.y(), 0.0), intrinsics_.height - 1.0));
+  const Pose C = CameraPose(t);
+  const CameraIntrinsics& k = intrinsics_;
+  const Eigen::Vector3d ray =
+      C.R * Eigen::Vector3d((px.x() - k.cx) / k.fx, (px.y() - k.cy) / k.fy, 1.0);
+  auto covers = [&](const Billboard& b) {
+    const Pose P = b.pose(t);
+    const Eigen::Vector3d n = P.R * Eigen::Vector3d::UnitZ();
+    const double den = n.dot(ray);
+    if (std::abs(den) < 1e-12) return false;
+    const double s = n.dot(P.p - C.p) / den;
+    if (s <= 0) return false;
+    const Eigen::Vector3d local = P.R.conjugate() * (C.p + s * ray - P.p);
+    const Eigen::Vector2d uv = local.head<2>() / b.metres_per_px + b.anchor_px;
+    const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
+    if (x < 0 || y < 0 || x >= b.bgra.cols || y >= b.bgra.rows) return false;
+    return b.bgra.at<cv::Vec4b>(y, x)[3] >= 128;
+  };
+  return covers(face_) || (options_.render_torso && covers(torso_));
 }
 
 bool Simulator::BackgroundPixel(int i, const Eigen::Vector3d& d, Eigen::Vector2d* px) const {

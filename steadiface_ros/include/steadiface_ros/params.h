@@ -76,10 +76,13 @@ steadiface::Status LoadOptions(const ParamSource& params,
                                steadiface::PipelineOptions* pipeline,
                                WrapperOptions* wrapper);
 
-/// dynamic_reconfigure <-> stabilizer options.
+/// dynamic_reconfigure <-> stabilizer options, and the warp mode with the
+/// layered warp's band options.
 void ApplyConfig(const steadiface::SteadifaceConfig& config,
                  steadiface::StabilizerOptions* options);
+void ApplyConfig(const steadiface::SteadifaceConfig& config, steadiface::WarpMode* mode,
+                 steadiface::LayeredWarpOptions* layered);
 steadiface::SteadifaceConfig ConfigFromOptions(
-    const steadiface::StabilizerOptions& options);
+    const steadiface::StabilizerOptions& options, const steadiface::WarpOptions& warp);
 
 }  // namespace steadiface_ros

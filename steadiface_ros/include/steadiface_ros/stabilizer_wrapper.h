@@ -126,6 +126,10 @@ class StabilizerWrapper {
   void Flush();
 
   void RequestStabilizerOptions(const steadiface::StabilizerOptions& options);
+  /// The same for the warp mode and the layered warp's options (applied
+  /// only when they differ from those in effect: rebuilding the warper
+  /// restarts the layered warp's smoothing).
+  void RequestLayering(steadiface::WarpMode mode, const steadiface::LayeredWarpOptions& layered);
 
   WrapperStatus Status() const;
   const steadiface::PipelineOptions& pipeline_options() const { return options_; }
@@ -173,6 +177,9 @@ class StabilizerWrapper {
   std::mutex options_mutex_;
   bool options_pending_ = false;
   steadiface::StabilizerOptions requested_options_;
+  bool layering_pending_ = false;
+  steadiface::WarpMode requested_mode_ = steadiface::WarpMode::kGlobal;
+  steadiface::LayeredWarpOptions requested_layered_;
 };
 
 }  // namespace steadiface_ros

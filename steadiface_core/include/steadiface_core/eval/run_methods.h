@@ -17,6 +17,7 @@ enum class Method {
   kNone,        ///< input as is
   kGyroOnly,    ///< steadiface with w_f = 0 (no face)
   kSteadiface,  ///< the full method, dlib landmarks from the rendered frames
+  kSteadifaceLayered,  ///< the full method with the layered warp (issue 15)
 };
 const char* MethodName(Method m);
 

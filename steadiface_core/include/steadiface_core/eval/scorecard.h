@@ -22,12 +22,19 @@ struct FrameWarp {
     kIdentity,    ///< no stabilization: output = input
     kPose,        ///< steadiface: virtual pose + per-row real rotation
     kHomography,  ///< any per-frame homography (input px -> output px)
+    kMesh,        ///< a warp mesh (output vertices -> input px), e.g. layered
   };
   Kind kind = Kind::kIdentity;
   Eigen::Quaterniond R_v = Eigen::Quaterniond::Identity();
   Eigen::Vector2d t = Eigen::Vector2d::Zero();
   RowRotations rows;
   Eigen::Matrix3d H = Eigen::Matrix3d::Identity();
+  /// kMesh: vertex columns / rows at output px u, v; the source (input px)
+  /// of vertex (i, j) at [j * u.size() + i]; optionally the background
+  /// layer's mesh and each vertex's layer blend (for the band's figures).
+  std::vector<double> mesh_u, mesh_v;
+  std::vector<Eigen::Vector2f> mesh_source, mesh_background;
+  std::vector<double> mesh_blend;
   /// Per-stage time of this frame [ms] (name, value); optional.
   std::vector<std::pair<std::string, double>> stage_ms;
 };
@@ -65,6 +72,25 @@ struct Score {
   double distortion = 1.0;
   /// Fraction of frames with any undefined output pixel.
   double undefined_fraction = 0.0;
+  /// Jitter of the far background where it is visible: a denser grid of
+  /// directions, each point dropped on frames where the subject (face or
+  /// torso) covers it, mean over the points [output px]. The fair
+  /// background figure for a warp that treats the subject differently.
+  double visible_background_jitter_px = NAN;
+  /// Straightness of straight background lines (world great circles) in
+  /// the output, where visible: the largest distance of a line's points
+  /// from their fitted line over all lines and frames [output px], and the
+  /// frame where it happened. A global warp keeps them straight (~0).
+  double line_deviation_px = 0.0;
+  int line_deviation_frame = -1;
+  /// kMesh: cells' singular-value ratios over all frames: the worst, the
+  /// 1st percentile (99 % of cells are at least this), and fold-overs.
+  double min_cell_ratio = 1.0, p01_cell_ratio = 1.0;
+  int folded_cells = 0;
+  /// kMesh with a background mesh: high-pass RMS of the band vertices'
+  /// offsets from the background layer, in output px, mean over vertices
+  /// in the band on >= half of the frames (NaN without such vertices).
+  double band_jitter_px = NAN;
   /// Per-stage time, median and p99 [ms].
   std::vector<std::pair<std::string, std::pair<double, double>>> stage_ms;
 };
@@ -122,6 +148,16 @@ class Scorecard {
   const ProtrusionGeometry protrusion_;
   const ScorecardOptions options_;
   std::vector<Eigen::Vector3d> background_dirs_;
+  std::vector<Eigen::Vector3d> visible_dirs_;
+  std::vector<std::vector<Eigen::Vector2d>> visible_out_;  // [point][frame]
+  // Straight world lines: sample directions per line.
+  std::vector<std::vector<Eigen::Vector3d>> lines_;
+  double line_dev_ = 0.0;
+  int line_dev_frame_ = -1;
+  std::vector<double> cell_ratios_;
+  int folded_ = 0;
+  std::vector<std::vector<Eigen::Vector2d>> band_offsets_;  // [vertex][frame]
+  std::vector<int> band_frames_;
   std::vector<Sample> samples_;
   std::vector<std::vector<Eigen::Vector2d>> background_out_;  // [point][frame]
   std::vector<Eigen::Vector2d> head_out_;

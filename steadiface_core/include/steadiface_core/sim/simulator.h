@@ -57,6 +57,12 @@ struct SimulatorOptions {
   double body_bob_m = 0.02, body_sway_m = 0.01, body_bob_hz = 1.8;
   /// Render the face at all (false: background only, e.g. a robot camera).
   bool render_face = true;
+  /// Render neck and shoulders under the face, moving with the head's
+  /// position (not its turning or nodding), torso_depth_m behind the face
+  /// plane [m]; shoulders torso_width_m wide [m].
+  bool render_torso = false;
+  double torso_depth_m = 0.04;
+  double torso_width_m = 0.42;
   /// Face width on the billboard [m].
   double face_width_m = 0.15;
   /// IMU: gyro rate [Hz], white noise [rad/s], constant bias [rad/s],
@@ -77,7 +83,9 @@ struct SimulatorOptions {
   double brightness_gain = 1.6;
 };
 
-/// Presets: still, walk, pan, run, occlusion, two_faces, turn_away.
+/// Presets: still, walk, pan, run, occlusion, two_faces, turn_away, vlog
+/// (a walking selfie at arm's length, 0.7 m, with head and shoulders in
+/// front of a building: what the layered warp is judged on).
 Status ApplyPreset(const std::string& name, SimulatorOptions* options);
 const std::vector<std::string>& PresetNames();
 
@@ -123,6 +131,9 @@ class Simulator {
 
   /// True camera-to-world pose at time t [s].
   Pose CameraPose(double t) const;
+  /// True when the subject (face or torso billboard, alpha >= 0.5) covers
+  /// input pixel `px` of frame i (the pose at the pixel's row).
+  bool SubjectCovers(int i, const Eigen::Vector2d& px) const;
   /// Where a world direction at infinity appears in frame i [px], at its
   /// own row. False when behind the camera.
   bool BackgroundPixel(int i, const Eigen::Vector3d& direction,
@@ -148,7 +159,7 @@ class Simulator {
   /// Time in the real trace for sequence time t (mirrored past its end).
   double RealGyroTime(double t, double* sign) const;
   std::unique_ptr<InfiniteBackground> background_;
-  Billboard face_, second_face_, occluder_;
+  Billboard face_, second_face_, occluder_, torso_;
   Eigen::Vector2d face_centre_uv_ = Eigen::Vector2d::Zero();
   std::vector<GyroSample> imu_;
 };

@@ -1,0 +1,153 @@
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include "steadiface_core/layered/subject_region.h"
+#include "steadiface_core/status.h"
+
+namespace steadiface {
+
+/// Options of the per-frame mesh optimization that joins the two layers.
+struct LayerBlendOptions {
+  /// Width of the transition band where the mesh bends from the subject
+  /// layer to the background layer, in jaw widths of the face (so it scales
+  /// with the face's size in the output) [-].
+  double band_width = 0.5;
+  /// Fraction of the band that lies inside the region's outline, on the
+  /// subject's periphery (hair, neck, shoulders), rather than on the
+  /// background [0-1].
+  double band_inside = 0.5;
+  /// Cap on the layer offset the band absorbs, measured at the head centre,
+  /// as a fraction of the band's width [-]: the band's local stretch stays
+  /// below about 1.5x this (the smoothstep's steepest slope). Beyond it the
+  /// subject follows the background layer in part (the head steadies less,
+  /// the band stretches less). 0 = no cap.
+  double max_offset = 0.4;
+  /// The layer offset's slow part shifts the whole frame instead of bending
+  /// the band, so the band absorbs only the offset's fast part (slow drift
+  /// is intentional framing, such as a pan the face turns with, not shake).
+  /// "Slow": a critically damped type-2 tracking loop at this natural
+  /// frequency (ramps pass without lag) followed by a first-order low-pass
+  /// at 5x it (the loop alone passes about 2 f / f_motion of faster
+  /// motion). 0 = off (the band absorbs the whole offset) [Hz].
+  double offset_lowpass_hz = 0.1;
+  /// Data-term weight of vertices inside the band relative to those in the
+  /// core or beyond the band (1) [-].
+  double band_data_weight = 0.02;
+  /// Shape-preserving (similarity) term weight per triangle, Liu et al.
+  /// 2009 [-].
+  double shape_weight = 1.0;
+  /// Temporal smoothness of the vertex offsets between frames [-].
+  double temporal_weight = 0.05;
+};
+
+Status ValidateLayerBlendOptions(const LayerBlendOptions& options);
+
+/// What the blend did this frame.
+struct LayerBlendReport {
+  bool layered = false;  ///< a region with blend > 0 was applied
+  double blend = 0.0;    ///< the region's g
+  /// Band width this frame, and its outer edge's distance outside the
+  /// region's outline (the inner edge is band_px inside that) [output px].
+  double band_px = 0.0, band_outer_px = 0.0;
+  /// The fast part of the layer offset at the head centre, before / after
+  /// the cap [output px], and the slow part that shifts the whole frame
+  /// [output px].
+  double offset_px = 0.0, capped_offset_px = 0.0, shift_px = 0.0;
+  /// Fraction of the offset kept after the protrusion pull [0-1] (1 = none).
+  double protrusion_keep = 1.0;
+  /// Worst (smallest) and 1st-percentile singular-value ratio of the cells'
+  /// local maps, and cells whose orientation flipped (fold-over).
+  double min_cell_ratio = 1.0, p01_cell_ratio = 1.0;
+  int folded_cells = 0;
+  /// The same ratio relative to the background layer's own map (the
+  /// distortion the blend adds) [-].
+  double min_added_ratio = 1.0;
+  /// RMS change of the band vertices' offsets since the last frame [input px].
+  double band_vertex_step_px = 0.0;
+  double solve_ms = 0.0;
+};
+
+/// Joins two per-vertex source meshes (the subject layer's and the
+/// background layer's, same grid of output vertices) into one:
+///
+///   min_d  sum_k w_k |d_k - T_k|^2                    (data, both layers)
+///        + w_s sum_tri |S_tri(d)|^2                    (shape, Liu 2009)
+///        + w_t sum_k |(d_k - T_k) - (d_k - T_k)^prev|^2 (temporal)
+///   T_k = g S + a_k (D_k - S)
+///
+/// where d_k = source_k - background_k is the final mesh's offset from the
+/// background layer, D_k = subject_k - background_k the layer offset, S the
+/// slow part of the offset at the head centre (offset_lowpass_hz; it shifts
+/// the whole frame), g the region's blend, a_k
+/// the region's blend at vertex k (g in the core, falling to 0 over the band
+/// by a smoothstep; the band straddles the region's outline), w_k = 1 in the
+/// core and beyond the band and band_data_weight inside the band. S_tri is the similarity residual of
+/// Liu et al.: each triangle's third vertex expressed in the frame of the
+/// other two must keep the relative coordinates it has on the output grid,
+/// so d may translate, rotate and scale locally but not shear. Four
+/// triangles per cell. Linear least squares: a fixed sparse pattern,
+/// factorized per frame (Eigen SimplicialLDLT).
+///
+/// Then no undefined pixels: every final vertex must land inside the input
+/// frame (the cells are bilinear, so the whole cell then does); otherwise d
+/// is scaled towards 0 (the background layer, already protrusion-free) by
+/// bisection.
+class LayerBlend {
+ public:
+  /// `u`, `v`: output pixel positions of the vertex columns and rows.
+  LayerBlend(const std::vector<double>& u, const std::vector<double>& v,
+             const LayerBlendOptions& options);
+
+  /// Writes the joined mesh into `*source` (same layout as the inputs);
+  /// `dt` is the time since the last frame [s] (<= 0 on the first);
+  /// `input_width/height` bound the sources.
+  void Blend(const std::vector<Eigen::Vector2f>& subject,
+             const std::vector<Eigen::Vector2f>& background,
+             const SubjectRegion& region, double dt, int input_width, int input_height,
+             std::vector<Eigen::Vector2f>* source, LayerBlendReport* report);
+
+  /// Blend weight a_k of each vertex of the last Blend [0-1].
+  const std::vector<double>& vertex_blend() const { return alpha_; }
+  /// Singular-value ratio of each cell of the last joined mesh [0-1].
+  const std::vector<double>& cell_ratios() const { return ratios_scratch_; }
+  void reset() {
+    has_previous_ = false;
+    has_slow_ = false;
+    has_smooth_ = false;
+  }
+
+ private:
+  int cols_ = 0, rows_ = 0;
+  std::vector<double> u_, v_;
+  LayerBlendOptions options_;
+  Eigen::SparseMatrix<double> shape_;  // w_s S^T S
+  Eigen::SparseMatrix<double> system_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver_;
+  bool analyzed_ = false;
+  bool has_previous_ = false;
+  Eigen::VectorXd d_previous_, e_previous_;
+  bool has_slow_ = false, has_smooth_ = false;
+  Eigen::Vector2d smooth_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d slow_ = Eigen::Vector2d::Zero(), slow_rate_ = Eigen::Vector2d::Zero();
+  std::vector<double> alpha_;
+  std::vector<double> ratios_scratch_;
+};
+
+/// Singular-value ratios of a mesh's cells: for each cell, the ratio of the
+/// smaller to the larger singular value of its local linear map (output ->
+/// source), and whether any corner triangle flipped orientation. With
+/// `reference`, the ratio of the map relative to the reference's (the
+/// distortion one mesh adds to the other). Returns the ratios in `*ratio`
+/// (one per cell) and the number of flipped cells.
+int CellRatios(int cols, int rows, const std::vector<double>& u,
+               const std::vector<double>& v,
+               const std::vector<Eigen::Vector2f>& source,
+               const std::vector<Eigen::Vector2f>* reference,
+               std::vector<double>* ratio);
+
+}  // namespace steadiface

@@ -1,0 +1,342 @@
+#include "steadiface_core/layered/layer_blend.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+namespace steadiface {
+namespace {
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+// Ratio of the smaller to the larger singular value of a 2x2 map.
+double SingularRatio(const Eigen::Matrix2d& M) {
+  const double f2 = M.squaredNorm();
+  const double det = M.determinant();
+  const double disc = std::sqrt(std::max(0.0, f2 * f2 - 4.0 * det * det));
+  const double s1 = std::sqrt(std::max(0.0, 0.5 * (f2 + disc)));
+  const double s2 = std::sqrt(std::max(0.0, 0.5 * (f2 - disc)));
+  return s1 > 0 ? s2 / s1 : 0.0;
+}
+
+// The four corner triangles of cell (a, b, c, e) = (i,j), (i+1,j),
+// (i+1,j+1), (i,j+1): vertex V1 and its two neighbours V2, V3 along the
+// cell's edges, counter-clockwise in the output (x right, y down).
+struct Triangle {
+  int v1, v2, v3;
+};
+
+// Data weight of the vertices in the core and beyond the band: they follow
+// their layer; the shape term only shapes the band.
+constexpr double kRigidWeight = 100.0;
+
+double Excess(const Eigen::Vector2d& p, double w1, double h1) {
+  return std::max({0.0, -p.x(), p.x() - w1, -p.y(), p.y() - h1});
+}
+
+}  // namespace
+
+Status ValidateLayerBlendOptions(const LayerBlendOptions& o) {
+  auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  std::ostringstream err;
+  if (!in(o.band_width, 0.02, 10.0)) {
+    err << "warp.layered.band_width must be in [0.02, 10] jaw widths, got " << o.band_width;
+  } else if (!in(o.band_inside, 0.0, 1.0)) {
+    err << "warp.layered.band_inside must be in [0, 1], got " << o.band_inside;
+  } else if (!in(o.max_offset, 0.0, 10.0)) {
+    err << "warp.layered.max_offset must be in [0, 10] band widths (0 = no cap), got "
+        << o.max_offset;
+  } else if (!in(o.offset_lowpass_hz, 0.0, 10.0)) {
+    err << "warp.layered.offset_lowpass_hz must be in [0, 10] Hz (0 = off), got "
+        << o.offset_lowpass_hz;
+  } else if (!in(o.band_data_weight, 1e-6, 1.0) || !in(o.shape_weight, 0.0, 1e4) ||
+             !in(o.temporal_weight, 0.0, 1e4)) {
+    err << "warp.layered: band_data_weight must be in (0, 1], shape_weight and "
+           "temporal_weight in [0, 1e4]";
+  }
+  if (err.tellp() != 0) return Status::Error(err.str());
+  return Status::Ok();
+}
+
+LayerBlend::LayerBlend(const std::vector<double>& u, const std::vector<double>& v,
+                       const LayerBlendOptions& options)
+    : cols_(static_cast<int>(u.size())),
+      rows_(static_cast<int>(v.size())),
+      u_(u),
+      v_(v),
+      options_(options) {
+  const int n = cols_ * rows_;
+  std::vector<Eigen::Triplet<double>> s;
+  int row = 0;
+  auto id = [this](int i, int j) { return j * cols_ + i; };
+  for (int j = 0; j + 1 < rows_; ++j) {
+    for (int i = 0; i + 1 < cols_; ++i) {
+      const int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), e = id(i, j + 1);
+      for (const Triangle& t : {Triangle{a, b, e}, Triangle{b, c, a}, Triangle{c, e, b},
+                                Triangle{e, a, c}}) {
+        auto pos = [this](int k) { return Eigen::Vector2d(u_[k % cols_], v_[k / cols_]); };
+        // V1 - V2 = p (V3 - V2) + q R90 (V3 - V2), R90 (x, y) = (y, -x).
+        const Eigen::Vector2d ed = pos(t.v3) - pos(t.v2);
+        Eigen::Matrix2d E;
+        E << ed.x(), ed.y(), ed.y(), -ed.x();
+        const Eigen::Vector2d pq = E.inverse() * (pos(t.v1) - pos(t.v2));
+        const double p = pq.x(), q = pq.y();
+        // r_x = d1x - d2x - p (d3x - d2x) - q (d3y - d2y)
+        // r_y = d1y - d2y - p (d3y - d2y) + q (d3x - d2x)
+        auto add = [&s](int r, int k, double c0) { s.emplace_back(r, k, c0); };
+        add(row, 2 * t.v1, 1.0);
+        add(row, 2 * t.v2, -1.0 + p);
+        add(row, 2 * t.v3, -p);
+        add(row, 2 * t.v2 + 1, q);
+        add(row, 2 * t.v3 + 1, -q);
+        add(row + 1, 2 * t.v1 + 1, 1.0);
+        add(row + 1, 2 * t.v2 + 1, -1.0 + p);
+        add(row + 1, 2 * t.v3 + 1, -p);
+        add(row + 1, 2 * t.v2, -q);
+        add(row + 1, 2 * t.v3, q);
+        row += 2;
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> S(std::max(row, 1), 2 * n);
+  S.setFromTriplets(s.begin(), s.end());
+  shape_ = options_.shape_weight * Eigen::SparseMatrix<double>(S.transpose() * S);
+  // Make sure every diagonal entry is in the pattern.
+  Eigen::SparseMatrix<double> I(2 * n, 2 * n);
+  I.setIdentity();
+  shape_ = shape_ + 0.0 * I;
+  shape_.makeCompressed();
+  d_previous_ = Eigen::VectorXd::Zero(2 * n);
+  e_previous_ = Eigen::VectorXd::Zero(2 * n);
+  alpha_.assign(n, 0.0);
+}
+
+void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
+                       const std::vector<Eigen::Vector2f>& background,
+                       const SubjectRegion& region, double dt, int input_width, int input_height,
+                       std::vector<Eigen::Vector2f>* source, LayerBlendReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  const int n = cols_ * rows_;
+  LayerBlendReport r;
+  r.blend = region.valid ? region.blend : 0.0;
+  source->resize(n);
+  if (!region.valid || region.blend <= 0.0) {
+    *source = background;
+    alpha_.assign(n, 0.0);
+    d_previous_.setZero();
+    e_previous_.setZero();
+    has_previous_ = true;
+    has_slow_ = false;
+    has_smooth_ = false;
+    r.solve_ms = 0.0;
+    *report = r;
+    CellRatios(cols_, rows_, u_, v_, *source, nullptr, &ratios_scratch_);
+    return;
+  }
+  r.layered = true;
+  // Output px per input px, from the background mesh's middle row.
+  double in_per_out = 0.0;
+  {
+    const int j = rows_ / 2;
+    double sum = 0.0, span = 0.0;
+    for (int i = 0; i + 1 < cols_; ++i) {
+      sum += (background[j * cols_ + i + 1] - background[j * cols_ + i]).cast<double>().norm();
+      span += u_[i + 1] - u_[i];
+    }
+    in_per_out = span > 0 ? sum / span : 1.0;
+  }
+  // Blend weight and data weight per vertex.
+  // The band runs from band_inside * B inside the outline to the rest of B
+  // outside it.
+  const double B = std::max(1.0, options_.band_width * region.jaw_width);
+  const double outer = (1.0 - options_.band_inside) * B;
+  r.band_px = B;
+  r.band_outer_px = outer;
+  std::vector<double> w(n);
+  for (int k = 0; k < n; ++k) {
+    const double dist = region.SignedDistance(Eigen::Vector2d(u_[k % cols_], v_[k / cols_]));
+    const double s = std::min(1.0, std::max(0.0, (outer - dist) / B));
+    alpha_[k] = region.blend * s * s * (3.0 - 2.0 * s);
+    w[k] = s <= 0.0 || s >= 1.0 ? kRigidWeight : options_.band_data_weight;
+  }
+  // Layer offset at the head centre (bilinear in the vertex grid), its slow
+  // part (a shift of the whole frame), and the cap on the rest.
+  Eigen::Vector2d shift = Eigen::Vector2d::Zero(), fast = Eigen::Vector2d::Zero();
+  {
+    const Eigen::Vector2d h = region.head_centre;
+    int i = 0, j = 0;
+    while (i + 2 < cols_ && u_[i + 1] < h.x()) ++i;
+    while (j + 2 < rows_ && v_[j + 1] < h.y()) ++j;
+    const double a = std::min(1.0, std::max(0.0, (h.x() - u_[i]) / (u_[i + 1] - u_[i])));
+    const double b = std::min(1.0, std::max(0.0, (h.y() - v_[j]) / (v_[j + 1] - v_[j])));
+    auto D = [&](int ii, int jj) {
+      const int k = jj * cols_ + ii;
+      return (subject[k] - background[k]).cast<double>().eval();
+    };
+    const Eigen::Vector2d Dc = (1 - a) * (1 - b) * D(i, j) + a * (1 - b) * D(i + 1, j) +
+                               (1 - a) * b * D(i, j + 1) + a * b * D(i + 1, j + 1);
+    // The slow part of the offset moves the whole frame (a type-2 tracking
+    // loop: no lag on ramps such as a pan); the band absorbs the rest.
+    const double wn = 2.0 * M_PI * options_.offset_lowpass_hz;
+    if (wn <= 0.0) {
+      slow_.setZero();
+      slow_rate_.setZero();
+    } else if (!has_slow_ || !(dt > 0.0)) {
+      slow_ = Dc;
+      slow_rate_.setZero();
+      has_slow_ = true;
+    } else {
+      const double h = std::min(dt, 0.5 / wn);  // keep the loop stable on long gaps
+      const Eigen::Vector2d e = Dc - slow_;
+      slow_rate_ += wn * wn * e * h;
+      slow_ += (slow_rate_ + 2.0 * wn * e) * h;
+    }
+    // A first-order low-pass at post_ratio x the loop's frequency on top:
+    // the loop alone passes ~2 wn / w of faster motion (its zero).
+    constexpr double post_ratio = 5.0;
+    if (wn <= 0.0 || !(dt > 0.0) || !has_smooth_) {
+      smooth_ = slow_;
+      has_smooth_ = wn > 0.0;
+    } else {
+      smooth_ += (1.0 - std::exp(-dt * post_ratio * wn)) * (slow_ - smooth_);
+    }
+    shift = region.blend * smooth_;
+    fast = Dc - smooth_;
+    r.offset_px = region.blend * fast.norm() / in_per_out;
+    r.shift_px = shift.norm() / in_per_out;
+  }
+  double cap = 1.0;
+  const double max_offset_px = options_.max_offset * B;
+  if (max_offset_px > 0 && r.offset_px > max_offset_px) cap = max_offset_px / r.offset_px;
+  r.capped_offset_px = r.offset_px * cap;
+  // The normal equations.
+  if (!analyzed_) {
+    solver_.analyzePattern(shape_);
+    analyzed_ = true;
+  }
+  system_ = shape_;
+  Eigen::VectorXd rhs(2 * n);
+  const double wt = has_previous_ ? options_.temporal_weight : 0.0;
+  Eigen::VectorXd target(2 * n);
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector2d D = (subject[k] - background[k]).cast<double>();
+    target.segment<2>(2 * k) = shift + alpha_[k] * cap * (D - smooth_);
+  }
+  for (int k = 0; k < n; ++k) {
+    for (int c = 0; c < 2; ++c) {
+      // Temporal: the correction d - target changes slowly (not d itself,
+      // which must follow the subject without lag).
+      const int q = 2 * k + c;
+      system_.coeffRef(q, q) += w[k] + wt;
+      rhs(q) = w[k] * target(q) + wt * (target(q) + e_previous_(q));
+    }
+  }
+  solver_.factorize(system_);
+  Eigen::VectorXd d = solver_.solve(rhs);
+  if (solver_.info() != Eigen::Success || !d.allFinite()) {
+    // Cannot happen for an SPD system; keep the plain blend if it does.
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector2d D = (subject[k] - background[k]).cast<double>();
+      d.segment<2>(2 * k) = target.segment<2>(2 * k);
+    }
+  }
+  // No undefined pixels: scale d towards the background layer if a vertex
+  // leaves the input frame (more than the background's own vertex does).
+  const double w1 = input_width - 1.0, h1 = input_height - 1.0;
+  auto feasible = [&](double s) {
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector2d bk = background[k].cast<double>();
+      if (Excess(bk + s * d.segment<2>(2 * k), w1, h1) > Excess(bk, w1, h1) + 1e-3) return false;
+    }
+    return true;
+  };
+  double keep = 1.0;
+  if (!feasible(1.0)) {
+    double lo = 0.0, hi = 1.0;
+    for (int it = 0; it < 12; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (feasible(mid) ? lo : hi) = mid;
+    }
+    keep = lo;
+    d *= keep;
+  }
+  r.protrusion_keep = keep;
+  // Band vertex flicker, then the final mesh.
+  double step2 = 0.0;
+  int band = 0;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector2d dk = d.segment<2>(2 * k);
+    if (alpha_[k] > 0.0 && alpha_[k] < region.blend && has_previous_) {
+      step2 += (dk - d_previous_.segment<2>(2 * k)).squaredNorm();
+      ++band;
+    }
+    // Clamp to the frame (or to the background vertex's own excursion):
+    // removes rounding, never moves a vertex by more than ~1e-3 px.
+    const Eigen::Vector2d bk = background[k].cast<double>();
+    const double ex = Excess(bk, w1, h1);
+    const Eigen::Vector2d q = (bk + dk)
+                                  .cwiseMax(Eigen::Vector2d::Constant(-ex))
+                                  .cwiseMin(Eigen::Vector2d(w1 + ex, h1 + ex));
+    (*source)[k] = q.cast<float>();
+  }
+  r.band_vertex_step_px = band > 0 ? std::sqrt(step2 / band) : 0.0;
+  d_previous_ = d;
+  e_previous_ = d - target;
+  has_previous_ = true;
+  // Distortion of the result.
+  r.folded_cells = CellRatios(cols_, rows_, u_, v_, *source, nullptr, &ratios_scratch_);
+  std::vector<double> sorted = ratios_scratch_;
+  if (!sorted.empty()) {
+    std::sort(sorted.begin(), sorted.end());
+    r.min_cell_ratio = sorted.front();
+    r.p01_cell_ratio = sorted[static_cast<size_t>(0.01 * (sorted.size() - 1))];
+  }
+  std::vector<double> added;
+  CellRatios(cols_, rows_, u_, v_, *source, &background, &added);
+  if (!added.empty()) r.min_added_ratio = *std::min_element(added.begin(), added.end());
+  r.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                   .count();
+  *report = r;
+}
+
+int CellRatios(int cols, int rows, const std::vector<double>& u, const std::vector<double>& v,
+               const std::vector<Eigen::Vector2f>& source,
+               const std::vector<Eigen::Vector2f>* reference, std::vector<double>* ratio) {
+  ratio->clear();
+  int folded = 0;
+  auto jac = [&](const std::vector<Eigen::Vector2f>& m, int i, int j, Eigen::Matrix2d* J,
+                 bool* flipped) {
+    const Eigen::Vector2d a = m[j * cols + i].cast<double>();
+    const Eigen::Vector2d b = m[j * cols + i + 1].cast<double>();
+    const Eigen::Vector2d c = m[(j + 1) * cols + i + 1].cast<double>();
+    const Eigen::Vector2d e = m[(j + 1) * cols + i].cast<double>();
+    const double du = u[i + 1] - u[i], dv = v[j + 1] - v[j];
+    J->col(0) = ((b - a) + (c - e)) / (2.0 * du);
+    J->col(1) = ((e - a) + (c - b)) / (2.0 * dv);
+    *flipped = Cross(b - a, e - a) <= 0 || Cross(c - b, a - b) <= 0 ||
+               Cross(e - c, b - c) <= 0 || Cross(a - e, c - e) <= 0;
+  };
+  for (int j = 0; j + 1 < rows; ++j) {
+    for (int i = 0; i + 1 < cols; ++i) {
+      Eigen::Matrix2d J;
+      bool flipped = false;
+      jac(source, i, j, &J, &flipped);
+      if (flipped) ++folded;
+      if (reference != nullptr) {
+        Eigen::Matrix2d R;
+        bool ref_flipped = false;
+        jac(*reference, i, j, &R, &ref_flipped);
+        if (std::abs(R.determinant()) > 1e-12) J = J * R.inverse();
+      }
+      ratio->push_back(flipped ? 0.0 : SingularRatio(J));
+    }
+  }
+  return folded;
+}
+
+}  // namespace steadiface

@@ -1,0 +1,278 @@
+// The layered warp (issue 15) piece by piece against closed forms: the
+// subject region's geometry and blend ramp, and the mesh optimization that
+// joins two layers (LayerBlend) on meshes whose layers differ by a known
+// translation.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "steadiface_core/layered/layer_blend.h"
+#include "steadiface_core/layered/subject_region.h"
+
+namespace steadiface {
+namespace {
+
+// A 33 x 19 vertex grid over a 640 x 360 output.
+struct Grid {
+  std::vector<double> u, v;
+  Grid() {
+    for (int i = 0; i <= 32; ++i) u.push_back(i * 639.0 / 32);
+    for (int j = 0; j <= 18; ++j) v.push_back(j * 359.0 / 18);
+  }
+  int n() const { return static_cast<int>(u.size() * v.size()); }
+  Eigen::Vector2d At(int k) const {
+    return Eigen::Vector2d(u[k % u.size()], v[k / u.size()]);
+  }
+  // The background layer: the output shifted into an 840 x 460 input.
+  std::vector<Eigen::Vector2f> Background() const {
+    std::vector<Eigen::Vector2f> b(n());
+    for (int k = 0; k < n(); ++k) b[k] = (At(k) + Eigen::Vector2d(100, 50)).cast<float>();
+    return b;
+  }
+};
+
+// A head of jaw width 100 px centred at (320, 150), shoulders below.
+SubjectRegion Region(double blend = 1.0) {
+  SubjectRegion r;
+  r.valid = true;
+  r.jaw_width = 100;
+  r.face_height = 90;
+  r.chin = Eigen::Vector2d(320, 215);
+  r.head_centre = Eigen::Vector2d(320, 150);
+  r.head_axes = Eigen::Vector2d(70, 75);
+  r.torso = true;
+  r.neck_half_width = 35;
+  r.shoulder_axes = Eigen::Vector2d(150, 180);
+  r.shoulder_centre = r.chin + Eigen::Vector2d(0, 0.6 * 90 + 180);
+  r.blend = blend;
+  return r;
+}
+
+LayerBlendOptions NoSlowShift() {
+  LayerBlendOptions o;
+  o.offset_lowpass_hz = 0.0;  // the band absorbs the whole offset
+  return o;
+}
+
+std::vector<Eigen::Vector2f> Shifted(const std::vector<Eigen::Vector2f>& b,
+                                     const Eigen::Vector2d& T) {
+  std::vector<Eigen::Vector2f> s = b;
+  for (auto& p : s) p += T.cast<float>();
+  return s;
+}
+
+TEST(SubjectRegionTest, SignedDistanceCoversHeadNeckAndShouldersOnly) {
+  const SubjectRegion r = Region();
+  EXPECT_LT(r.SignedDistance({320, 150}), -60.0);    // head centre
+  EXPECT_LT(r.SignedDistance({320, 240}), 0.0);      // neck
+  EXPECT_LT(r.SignedDistance({200, 350}), 0.0);      // shoulder
+  EXPECT_GT(r.SignedDistance({100, 100}), 100.0);    // background beside the head
+  // Circle-exact: a point 30 px right of the head ellipse's side.
+  EXPECT_NEAR(r.SignedDistance({320 + 70 + 30, 150}), 30.0, 1.0);
+}
+
+TEST(SubjectRegionTest, BlendStartsAtItsTargetThenRampsAtMostDtOverRamp) {
+  SubjectRegionOptions o;
+  o.ramp_s = 0.5;
+  SubjectRegionTracker t(o);
+  CameraModel model;
+  ASSERT_TRUE(CameraModel::Create(IntrinsicsFromHorizontalFov(640, 360, 1.1),
+                                  CameraModelOptions(), &model)
+                  .ok());
+  OutputGeometry out;
+  ASSERT_TRUE(OutputGeometry::Create(model, OutputOptions(), &out).ok());
+  const RowRotations rows(Eigen::Quaterniond::Identity(), 360);
+  // A frontal face: 68 points on a 0.2-wide ellipse in normalized units
+  // (jaw 0-16 along its lower half, brows 17-26 above the centre).
+  FaceObservation face;
+  face.valid = true;
+  for (int i = 0; i < 68; ++i) {
+    const double a = i <= 16 ? M_PI * i / 16.0 : -0.5 * M_PI + 0.05 * (i - 40);
+    face.landmarks.emplace_back(0.5 + 0.1 * std::cos(a), 0.5 + 0.12 * std::sin(a));
+  }
+  face.landmark_rows.assign(68, 180.0);
+  const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
+  const SubjectRegion& first = t.Update(model, out, I, Eigen::Vector2d::Zero(), rows, &face,
+                                        1.0, 0.0);
+  ASSERT_TRUE(first.valid);
+  EXPECT_DOUBLE_EQ(first.blend, 1.0);  // no previous output to jump from
+  // The output shows the middle 70 % of the width, magnified 1/0.7: the jaw
+  // spans 0.2 of the input width = 0.2 * 640 / 0.7 output px.
+  EXPECT_NEAR(first.jaw_width, 0.2 * 640 / 0.7, 3.0);
+  EXPECT_NEAR(first.head_centre.x(), 319.5, 2.0);
+  // The face is lost: the blend ramps to 0 by at most dt / ramp per frame.
+  const double dt = 1.0 / 30;
+  double previous = first.blend;
+  int frames = 0;
+  while (t.region().blend > 0.0 && frames < 100) {
+    const SubjectRegion& r = t.Update(model, out, I, Eigen::Vector2d::Zero(), rows, nullptr,
+                                      0.0, dt);
+    EXPECT_LE(previous - r.blend, dt / 0.5 + 1e-12);
+    EXPECT_DOUBLE_EQ(r.blend_step, previous - r.blend);
+    EXPECT_TRUE(r.valid);  // the last region is kept while it fades
+    previous = r.blend;
+    ++frames;
+  }
+  EXPECT_NEAR(frames, 15, 1);  // 0.5 s at 30 fps (rounding may add one)
+}
+
+// Layers that differ by a translation T: the core moves by T, the
+// background beyond the band not at all, the band in between, with no
+// fold-over and the stretch the band width implies.
+TEST(LayerBlendTest, CoreFollowsTheSubjectLayerAndTheBackgroundStaysPut) {
+  const Grid g;
+  const auto background = g.Background();
+  const Eigen::Vector2d T(8.0, -5.0);
+  LayerBlend blend(g.u, g.v, NoSlowShift());
+  std::vector<Eigen::Vector2f> out;
+  LayerBlendReport rep;
+  const SubjectRegion region = Region();
+  blend.Blend(Shifted(background, T), background, region, 0.0, 840, 460, &out, &rep);
+  ASSERT_TRUE(rep.layered);
+  const double B = 0.5 * 100, outer = 0.5 * B;
+  EXPECT_DOUBLE_EQ(rep.band_px, B);
+  // Vertices more than a cell (20 px) from the band follow their layer;
+  // those next to it are pulled by the shape term by at most 2 % of |T|.
+  int core = 0, far = 0;
+  for (int k = 0; k < g.n(); ++k) {
+    const Eigen::Vector2d d = (out[k] - background[k]).cast<double>();
+    const double dist = region.SignedDistance(g.At(k));
+    if (dist < outer - B) {
+      EXPECT_LT((d - T).norm(), (dist < outer - B - 20 ? 0.005 : 0.02) * T.norm())
+          << "core vertex " << k;
+      ++core;
+    } else if (dist > outer) {
+      EXPECT_LT(d.norm(), (dist > outer + 20 ? 0.005 : 0.02) * T.norm())
+          << "background vertex " << k;
+      ++far;
+    } else {
+      EXPECT_LE(d.norm(), 1.02 * T.norm()) << "band vertex " << k;
+    }
+  }
+  EXPECT_GT(core, 20);
+  EXPECT_GT(far, 200);
+  EXPECT_EQ(rep.folded_cells, 0);
+  // A translation |T| spread over B stretches by ~1.5 |T| / B at most.
+  EXPECT_GT(rep.min_cell_ratio, 1.0 - 2.0 * 1.5 * T.norm() / B);
+  EXPECT_LT(rep.min_cell_ratio, 0.995);  // the band does bend
+  EXPECT_NEAR(rep.offset_px, T.norm(), 0.05);
+  EXPECT_DOUBLE_EQ(rep.protrusion_keep, 1.0);
+}
+
+// The similarity term is what tames the bending: the optimized band is less
+// distorted than the plain per-vertex blend it starts from.
+TEST(LayerBlendTest, TheShapeTermDistortsLessThanThePlainBlend) {
+  const Grid g;
+  const auto background = g.Background();
+  const auto subject = Shifted(background, Eigen::Vector2d(12.0, 6.0));
+  LayerBlendOptions plain = NoSlowShift();
+  plain.shape_weight = 0.0;  // the data terms alone: exactly the blend
+  LayerBlend a(g.u, g.v, NoSlowShift()), b(g.u, g.v, plain);
+  std::vector<Eigen::Vector2f> out_a, out_b;
+  LayerBlendReport ra, rb;
+  a.Blend(subject, background, Region(), 0.0, 840, 460, &out_a, &ra);
+  b.Blend(subject, background, Region(), 0.0, 840, 460, &out_b, &rb);
+  EXPECT_GT(ra.min_cell_ratio, rb.min_cell_ratio + 0.02)
+      << "optimized " << ra.min_cell_ratio << ", plain " << rb.min_cell_ratio;
+}
+
+TEST(LayerBlendTest, TheCapBoundsTheOffsetAndTheStretch) {
+  const Grid g;
+  const auto background = g.Background();
+  const auto subject = Shifted(background, Eigen::Vector2d(60.0, 0.0));
+  LayerBlendOptions capped = NoSlowShift(), uncapped = NoSlowShift();
+  capped.max_offset = 0.4;
+  uncapped.max_offset = 0.0;
+  LayerBlend a(g.u, g.v, capped), b(g.u, g.v, uncapped);
+  std::vector<Eigen::Vector2f> out_a, out_b;
+  LayerBlendReport ra, rb;
+  a.Blend(subject, background, Region(), 0.0, 840, 460, &out_a, &ra);
+  b.Blend(subject, background, Region(), 0.0, 840, 460, &out_b, &rb);
+  EXPECT_NEAR(ra.capped_offset_px, 0.4 * 50, 1e-6);
+  EXPECT_NEAR(rb.capped_offset_px, 60.0, 0.05);
+  // At the head centre the capped mesh moves by the cap only.
+  const int centre = 9 * 33 + 16;  // vertex (319.5, 179.5): inside the core
+  EXPECT_NEAR((out_a[centre] - background[centre]).x(), 20.0, 0.2);
+  EXPECT_GT(ra.min_cell_ratio, rb.min_cell_ratio + 0.1);
+  EXPECT_EQ(ra.folded_cells, 0);
+}
+
+// No undefined pixels: when the subject layer would pull vertices out of
+// the input frame, the offset is scaled towards the background layer until
+// every vertex is inside.
+TEST(LayerBlendTest, PullsTowardsTheBackgroundInsteadOfLeavingTheFrame) {
+  const Grid g;
+  // The background layer exactly fills a 640 x 360 input.
+  std::vector<Eigen::Vector2f> background(g.n());
+  for (int k = 0; k < g.n(); ++k) background[k] = g.At(k).cast<float>();
+  const auto subject = Shifted(background, Eigen::Vector2d(0.0, 15.0));  // shoulders off the bottom
+  LayerBlend blend(g.u, g.v, NoSlowShift());
+  std::vector<Eigen::Vector2f> out;
+  LayerBlendReport rep;
+  blend.Blend(subject, background, Region(), 0.0, 640, 360, &out, &rep);
+  EXPECT_LT(rep.protrusion_keep, 0.05);
+  for (const auto& p : out) {
+    EXPECT_GE(p.x(), 0.0f);
+    EXPECT_GE(p.y(), 0.0f);
+    EXPECT_LE(p.x(), 639.0f);
+    EXPECT_LE(p.y(), 359.0f);
+  }
+}
+
+TEST(LayerBlendTest, BlendZeroIsExactlyTheBackgroundLayer) {
+  const Grid g;
+  const auto background = g.Background();
+  LayerBlend blend(g.u, g.v, LayerBlendOptions());
+  std::vector<Eigen::Vector2f> out;
+  LayerBlendReport rep;
+  blend.Blend(Shifted(background, {9, 9}), background, Region(0.0), 1.0 / 30, 840, 460, &out,
+              &rep);
+  EXPECT_FALSE(rep.layered);
+  for (int k = 0; k < g.n(); ++k) EXPECT_EQ(out[k], background[k]);
+}
+
+// The offset's slow part shifts the whole frame: a constant offset held for
+// seconds ends up in the shift, and the band has nothing left to absorb.
+TEST(LayerBlendTest, AHeldOffsetMovesIntoTheWholeFrameShift) {
+  const Grid g;
+  const auto background = g.Background();
+  const Eigen::Vector2d T(10.0, 0.0);
+  LayerBlend blend(g.u, g.v, LayerBlendOptions());
+  std::vector<Eigen::Vector2f> out;
+  LayerBlendReport rep;
+  // Start with no offset, then step to T and hold it 20 s.
+  blend.Blend(background, background, Region(), 0.0, 840, 460, &out, &rep);
+  double first_fast = -1.0;
+  for (int i = 0; i < 600; ++i) {
+    blend.Blend(Shifted(background, T), background, Region(), 1.0 / 30, 840, 460, &out, &rep);
+    if (i == 0) first_fast = rep.offset_px;
+  }
+  EXPECT_NEAR(first_fast, 10.0, 0.5);  // a step is fast: the band takes it
+  EXPECT_LT(rep.offset_px, 0.3);
+  EXPECT_NEAR(rep.shift_px, 10.0, 0.3);
+  const Eigen::Vector2d far = (out[0] - background[0]).cast<double>();  // a corner
+  EXPECT_NEAR(far.x(), 10.0, 0.3);
+}
+
+TEST(LayerBlendTest, RejectsBadOptions) {
+  LayerBlendOptions o;
+  EXPECT_TRUE(ValidateLayerBlendOptions(o).ok());
+  o.band_width = 0.0;
+  EXPECT_FALSE(ValidateLayerBlendOptions(o).ok());
+  o = LayerBlendOptions();
+  o.band_inside = 1.5;
+  EXPECT_FALSE(ValidateLayerBlendOptions(o).ok());
+  o = LayerBlendOptions();
+  o.max_offset = NAN;
+  const Status s = ValidateLayerBlendOptions(o);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("max_offset"), std::string::npos) << s.message();
+  SubjectRegionOptions r;
+  r.ramp_s = 0.0;
+  EXPECT_FALSE(ValidateSubjectRegionOptions(r).ok());
+}
+
+}  // namespace
+}  // namespace steadiface
