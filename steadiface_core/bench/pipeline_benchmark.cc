@@ -4,7 +4,8 @@
 // smoothing + Ceres solve + rolling-shutter mesh + maps + remap, at 640x360,
 // 1280x720 and 1920x1080, on 1 and 2 threads. Acquisition (the first
 // full-frame detection) is outside the timed loop. Counters: median stage
-// times over the timed frames.
+// times over the timed frames. The fourth argument picks the warp mode
+// (0 global, 1 layered: both layers' meshes and the band's optimization).
 #include <algorithm>
 #include <vector>
 
@@ -58,9 +59,10 @@ void BM_PipelineFrame(benchmark::State& state) {
   PipelineOptions po = eval::OptionsFor(*seq.sim, eval::Method::kSteadiface);
   po.render_output = true;
   po.warp.num_threads = static_cast<int>(state.range(2));
+  if (state.range(3) == 1) po.warp.mode = WarpMode::kLayered;
   std::unique_ptr<Pipeline> p;
   size_t g = 0, i = 0;
-  std::vector<double> face, stab, warp, total;
+  std::vector<double> face, stab, warp, mesh, total;
   double check_sum = 0.0, check_max = 0.0;
   // A fresh pipeline that has acquired the face on the first frame.
   auto restart = [&]() -> bool {
@@ -94,6 +96,7 @@ void BM_PipelineFrame(benchmark::State& state) {
     face.push_back(out.timings.face_ms);
     stab.push_back(out.timings.stabilizer_ms);
     warp.push_back(out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms);
+    mesh.push_back(out.timings.mesh_ms);
     total.push_back(out.timings.total_ms);
     check_sum += out.timings.check_ms;
     check_max = std::max(check_max, out.timings.check_ms);
@@ -101,6 +104,7 @@ void BM_PipelineFrame(benchmark::State& state) {
   state.counters["face_ms"] = Percentile(face, 0.5);
   state.counters["stabilizer_ms"] = Percentile(stab, 0.5);
   state.counters["warp_ms"] = Percentile(warp, 0.5);
+  state.counters["mesh_ms"] = Percentile(mesh, 0.5);
   // The gyro-vs-video check runs on one frame pair in `stride`: its mean
   // per frame, and the checked frames' cost.
   state.counters["check_mean_ms"] = total.empty() ? 0.0 : check_sum / total.size();
@@ -112,13 +116,16 @@ void BM_PipelineFrame(benchmark::State& state) {
 }
 
 BENCHMARK(BM_PipelineFrame)
-    ->Args({640, 360, 1})
-    ->Args({1280, 720, 1})
-    ->Args({1920, 1080, 1})
-    ->Args({640, 360, 2})
-    ->Args({1280, 720, 2})
-    ->Args({1920, 1080, 2})
-    ->ArgNames({"w", "h", "threads"})
+    ->Args({640, 360, 1, 0})
+    ->Args({1280, 720, 1, 0})
+    ->Args({1920, 1080, 1, 0})
+    ->Args({640, 360, 2, 0})
+    ->Args({1280, 720, 2, 0})
+    ->Args({1920, 1080, 2, 0})
+    ->Args({640, 360, 1, 1})
+    ->Args({1280, 720, 1, 1})
+    ->Args({1920, 1080, 1, 1})
+    ->ArgNames({"w", "h", "threads", "layered"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -310,6 +310,7 @@ int main(int argc, char** argv) {
            << ", \"line_deviation_px\": " << jnum(sc.line_deviation_px)
            << ", \"line_deviation_frame\": " << sc.line_deviation_frame
            << ", \"min_cell_ratio\": " << jnum(sc.min_cell_ratio)
+           << ", \"min_cell_ratio_frame\": " << sc.min_cell_ratio_frame
            << ", \"p01_cell_ratio\": " << jnum(sc.p01_cell_ratio)
            << ", \"folded_cells\": " << sc.folded_cells
            << ", \"band_jitter_px\": " << jnum(sc.band_jitter_px)

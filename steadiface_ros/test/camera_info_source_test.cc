@@ -238,6 +238,15 @@ TEST(ExampleOverlaysTest,
       l.wo.camera_info_url.empty());  // the driver publishes camera_info
 }
 
+TEST(ExampleOverlaysTest, LayeredSwitchesOnlyTheWarpMode) {
+  const Loaded l = LoadExample("layered.yaml");
+  const Loaded d = LoadExample("../default.yaml");
+  EXPECT_EQ(l.po.warp.mode, steadiface::WarpMode::kLayered);
+  EXPECT_EQ(d.po.warp.mode, steadiface::WarpMode::kGlobal);
+  EXPECT_TRUE(steadiface::SameLayering(steadiface::WarpMode::kLayered, d.po.warp.layered,
+                                       l.po.warp));
+}
+
 TEST(ExampleOverlaysTest, PhoneFrontCameraIsAHalfTurnAboutTheOpticalAxis) {
   const Loaded l = LoadExample("phone.yaml");
   EXPECT_FALSE(l.wo.imu_extrinsics_from_tf);

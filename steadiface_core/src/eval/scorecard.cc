@@ -292,6 +292,12 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     std::vector<double> ratios;
     folded_ += CellRatios(cols, rows, w.mesh_u, w.mesh_v, w.mesh_source, nullptr, &ratios);
     cell_ratios_.insert(cell_ratios_.end(), ratios.begin(), ratios.end());
+    for (double q : ratios) {
+      if (q < min_ratio_) {
+        min_ratio_ = q;
+        min_ratio_frame_ = index;
+      }
+    }
     const size_t n = w.mesh_source.size();
     if (w.mesh_background.size() == n && w.mesh_blend.size() == n) {
       // Output px per input px, from the background mesh's middle row.
@@ -446,6 +452,7 @@ Score Scorecard::Compute() const {
     sc.p01_cell_ratio = Percentile(cell_ratios_, 0.01);
   }
   sc.folded_cells = folded_;
+  sc.min_cell_ratio_frame = min_ratio_frame_;
   double band = 0.0;
   int nband = 0;
   for (size_t k = 0; k < band_offsets_.size(); ++k) {

@@ -323,6 +323,7 @@ int main(int argc, char** argv) {
   r.gyro_only = a.gyro_only;
   r.elapsed_s = elapsed;
   r.crop_ratio = po.warp.output.crop_ratio;
+  r.virtual_focal_scale = po.camera.virtual_focal_scale;
   r.have_input_info = stabilizer.have_input_info();
   r.input_info = stabilizer.input_info();
   const std::string report = steadiface_bag::MakeReport(r, sink, ws);

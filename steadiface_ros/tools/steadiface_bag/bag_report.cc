@@ -23,6 +23,13 @@ double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
   return steadiface::eval::Scorecard::HighPassRms(x, fps, cutoff);
 }
 
+// "gyro-only", "steadiface" or "steadiface-layered" (warp/mode layered).
+std::string MethodName(const ReportInputs& r, const BagSink& sink) {
+  if (r.gyro_only) return "gyro-only";
+  const bool layered = !sink.states.empty() && sink.states.back().warp_mode == "layered";
+  return layered ? "steadiface-layered" : "steadiface";
+}
+
 }  // namespace
 
 std::string MakeReport(const ReportInputs& r, const BagSink& sink,
@@ -59,7 +66,10 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
   // Ground truth (simulator bags): the true head centre and far-background
   // directions mapped through each frame's warp, as the scorecard does. The
   // warp of a frame is K_out R_v R_r^-1 K_in^-1 (middle-row R_r; the rolling
-  // shutter's within-frame part is below a pixel here).
+  // shutter's within-frame part is below a pixel here). In layered mode the
+  // head is mapped through the subject layer and the background through the
+  // background layer (the band and the slow whole-frame shift are not
+  // modelled here; steadiface_evaluate scores the exact mesh).
   std::string truth_json;
   if (!r.truth.empty() && !sink.states.empty() && r.have_input_info) {
     std::ifstream tf(r.truth);
@@ -99,7 +109,7 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
           "out_y,"
           "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
       traj_method.open(r.plot_dir + "/traj_" + r.plot_name + "_" +
-                       (r.gyro_only ? "gyro-only" : "steadiface") + ".csv");
+                       MethodName(r, sink) + ".csv");
       traj_method << head;
       if (!r.gyro_only) {
         traj_none.open(r.plot_dir + "/traj_" + r.plot_name + "_none.csv");
@@ -120,8 +130,23 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       const Eigen::Matrix3d K_out =
           (Eigen::Matrix3d() << ko[0], 0, ko[2], 0, ko[4], ko[5], 0, 0, 1)
               .finished();
-      const Eigen::Matrix3d H =
+      const bool layered = s.warp_mode == "layered" && s.has_background_layer;
+      Eigen::Matrix3d H_head =
           K_out * (Rv * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
+      Eigen::Matrix3d H = H_head;
+      if (layered) {
+        // The published intrinsics are the background layer's; the subject
+        // layer's differ by its principal offset (output px per unit of t:
+        // fx_out / f_v, f_v = fx_in / W_in * virtual_focal_scale).
+        Eigen::Quaterniond Rb;
+        steadiface_ros::ToEigen(s.background_rotation, &Rb);
+        const double f_v = r.input_info.K[0] / r.input_info.width * r.virtual_focal_scale;
+        Eigen::Matrix3d K_s = K_out;
+        K_s(0, 2) += ko[0] / f_v * (s.principal_offset[0] - s.background_principal_offset[0]);
+        K_s(1, 2) += ko[4] / f_v * (s.principal_offset[1] - s.background_principal_offset[1]);
+        H_head = K_s * (Rv * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
+        H = K_out * (Rb * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
+      }
       // A far-background direction fixed in the world: the first frame's
       // view centre, seen in each frame through the true middle-row rotation.
       const Eigen::Quaterniond R_true = t.rows[7];
@@ -134,7 +159,7 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       b_out.push_back(bout);
       Eigen::Vector2d hout = Eigen::Vector2d::Constant(NAN);
       if (t.in_view) {
-        hout = (H * t.head.homogeneous()).hnormalized();
+        hout = (H_head * t.head.homogeneous()).hnormalized();
         h_in.push_back(t.head);
         h_out.push_back(hout);
       }
@@ -249,7 +274,7 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       << Percentile(total_ms, 0.99) << "]}"
       << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5)
       << check_json << truth_json << ",\n  \"method\": \""
-      << (r.gyro_only ? "gyro-only" : "steadiface") << "\"\n}\n";
+      << MethodName(r, sink) << "\"\n}\n";
   return rep.str();
 }
 

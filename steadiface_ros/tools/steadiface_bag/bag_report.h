@@ -20,6 +20,9 @@ struct ReportInputs {
   bool gyro_only = false;
   double elapsed_s = 0.0;  ///< wall time of the run
   double crop_ratio = 0.0;
+  /// f_v / f_r (camera/virtual_focal_scale): with the output intrinsics it
+  /// gives the output px per unit of principal offset.
+  double virtual_focal_scale = 1.0;
   bool have_input_info = false;
   sensor_msgs::CameraInfo input_info;
 };

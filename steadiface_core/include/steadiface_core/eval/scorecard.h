@@ -86,6 +86,7 @@ struct Score {
   /// kMesh: cells' singular-value ratios over all frames: the worst, the
   /// 1st percentile (99 % of cells are at least this), and fold-overs.
   double min_cell_ratio = 1.0, p01_cell_ratio = 1.0;
+  int min_cell_ratio_frame = -1;
   int folded_cells = 0;
   /// kMesh with a background mesh: high-pass RMS of the band vertices'
   /// offsets from the background layer, in output px, mean over vertices
@@ -155,6 +156,8 @@ class Scorecard {
   double line_dev_ = 0.0;
   int line_dev_frame_ = -1;
   std::vector<double> cell_ratios_;
+  double min_ratio_ = 1.0;
+  int min_ratio_frame_ = -1;
   int folded_ = 0;
   std::vector<std::vector<Eigen::Vector2d>> band_offsets_;  // [vertex][frame]
   std::vector<int> band_frames_;

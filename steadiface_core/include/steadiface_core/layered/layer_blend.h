@@ -26,7 +26,7 @@ struct LayerBlendOptions {
   /// below about 1.5x this (the smoothstep's steepest slope). Beyond it the
   /// subject follows the background layer in part (the head steadies less,
   /// the band stretches less). 0 = no cap.
-  double max_offset = 0.4;
+  double max_offset = 0.35;
   /// The layer offset's slow part shifts the whole frame instead of bending
   /// the band, so the band absorbs only the offset's fast part (slow drift
   /// is intentional framing, such as a pan the face turns with, not shake).
