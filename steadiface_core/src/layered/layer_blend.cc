@@ -31,10 +31,6 @@ struct Triangle {
   int v1, v2, v3;
 };
 
-// Data weight of the vertices in the core and beyond the band: they follow
-// their layer; the shape term only shapes the band.
-constexpr double kRigidWeight = 100.0;
-
 double Excess(const Eigen::Vector2d& p, double w1, double h1) {
   return std::max({0.0, -p.x(), p.x() - w1, -p.y(), p.y() - h1});
 }
@@ -157,12 +153,12 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   const double outer = (1.0 - options_.band_inside) * B;
   r.band_px = B;
   r.band_outer_px = outer;
-  std::vector<double> w(n);
+  std::vector<bool> free_vertex(n);
   for (int k = 0; k < n; ++k) {
     const double dist = region.SignedDistance(Eigen::Vector2d(u_[k % cols_], v_[k / cols_]));
     const double s = std::min(1.0, std::max(0.0, (outer - dist) / B));
     alpha_[k] = region.blend * s * s * (3.0 - 2.0 * s);
-    w[k] = s <= 0.0 || s >= 1.0 ? kRigidWeight : options_.band_data_weight;
+    free_vertex[k] = s > 0.0 && s < 1.0;
   }
   // Layer offset at the head centre (bilinear in the vertex grid), its slow
   // part (a shift of the whole frame), and the cap on the rest.
@@ -214,36 +210,58 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   const double max_offset_px = options_.max_offset * B;
   if (max_offset_px > 0 && r.offset_px > max_offset_px) cap = max_offset_px / r.offset_px;
   r.capped_offset_px = r.offset_px * cap;
-  // The normal equations.
-  if (!analyzed_) {
-    solver_.analyzePattern(shape_);
-    analyzed_ = true;
-  }
-  system_ = shape_;
-  Eigen::VectorXd rhs(2 * n);
+  // Targets T_k. Vertices in the core and beyond the band are held at
+  // their targets (their data terms dominate: they follow their layer);
+  // only the band's vertices are unknowns of the least-squares problem
+  // (fixed vertices enter its right-hand side through the shape term).
   const double wt = has_previous_ ? options_.temporal_weight : 0.0;
   Eigen::VectorXd target(2 * n);
   for (int k = 0; k < n; ++k) {
     const Eigen::Vector2d D = (subject[k] - background[k]).cast<double>();
     target.segment<2>(2 * k) = shift + alpha_[k] * cap * (D - smooth_);
   }
+  Eigen::VectorXd d = target;
+  free_.assign(2 * n, -1);
+  int m = 0;
   for (int k = 0; k < n; ++k) {
-    for (int c = 0; c < 2; ++c) {
-      // Temporal: the correction d - target changes slowly (not d itself,
-      // which must follow the subject without lag).
-      const int q = 2 * k + c;
-      system_.coeffRef(q, q) += w[k] + wt;
-      rhs(q) = w[k] * target(q) + wt * (target(q) + e_previous_(q));
+    if (free_vertex[k]) {
+      free_[2 * k] = m++;
+      free_[2 * k + 1] = m++;
     }
   }
-  solver_.factorize(system_);
-  Eigen::VectorXd d = solver_.solve(rhs);
-  if (solver_.info() != Eigen::Success || !d.allFinite()) {
-    // Cannot happen for an SPD system; keep the plain blend if it does.
-    for (int k = 0; k < n; ++k) {
-      const Eigen::Vector2d D = (subject[k] - background[k]).cast<double>();
-      d.segment<2>(2 * k) = target.segment<2>(2 * k);
+  if (m > 0) {
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(m);
+    triplets_.clear();
+    for (int col = 0; col < shape_.outerSize(); ++col) {
+      const int fc = free_[col];
+      for (Eigen::SparseMatrix<double>::InnerIterator it(shape_, col); it; ++it) {
+        const int fr = free_[it.row()];
+        if (fr < 0) continue;
+        if (fc >= 0) {
+          triplets_.emplace_back(fr, fc, it.value());
+        } else {
+          rhs(fr) -= it.value() * target(col);  // a held neighbour
+        }
+      }
     }
+    for (int q = 0; q < 2 * n; ++q) {
+      const int f = free_[q];
+      if (f < 0) continue;
+      // Temporal: the correction d - T changes slowly (not d itself, which
+      // must follow the subject without lag).
+      const double wd = options_.band_data_weight;
+      triplets_.emplace_back(f, f, wd + wt);
+      rhs(f) += wd * target(q) + wt * (target(q) + e_previous_(q));
+    }
+    system_.resize(m, m);
+    system_.setFromTriplets(triplets_.begin(), triplets_.end());
+    solver_.compute(system_);
+    const Eigen::VectorXd x = solver_.solve(rhs);
+    if (solver_.info() == Eigen::Success && x.allFinite()) {
+      for (int q = 0; q < 2 * n; ++q) {
+        if (free_[q] >= 0) d(q) = x(free_[q]);
+      }
+    }  // else (cannot happen for this SPD system) the plain blend T stays
   }
   // No undefined pixels: scale d towards the background layer if a vertex
   // leaves the input frame (more than the background's own vertex does).

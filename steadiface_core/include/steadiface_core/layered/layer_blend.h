@@ -35,8 +35,8 @@ struct LayerBlendOptions {
   /// at 5x it (the loop alone passes about 2 f / f_motion of faster
   /// motion). 0 = off (the band absorbs the whole offset) [Hz].
   double offset_lowpass_hz = 0.1;
-  /// Data-term weight of vertices inside the band relative to those in the
-  /// core or beyond the band (1) [-].
+  /// Data-term weight of the band's vertices (those in the core and beyond
+  /// the band are held at their layer) [-].
   double band_data_weight = 0.02;
   /// Shape-preserving (similarity) term weight per triangle, Liu et al.
   /// 2009 [-].
@@ -75,23 +75,27 @@ struct LayerBlendReport {
 /// Joins two per-vertex source meshes (the subject layer's and the
 /// background layer's, same grid of output vertices) into one:
 ///
-///   min_d  sum_k w_k |d_k - T_k|^2                    (data, both layers)
+///   min_d  w_b sum_k |d_k - T_k|^2                     (data, both layers)
 ///        + w_s sum_tri |S_tri(d)|^2                    (shape, Liu 2009)
 ///        + w_t sum_k |(d_k - T_k) - (d_k - T_k)^prev|^2 (temporal)
 ///   T_k = g S + a_k (D_k - S)
+///   subject to d_k = T_k in the core and beyond the band
 ///
 /// where d_k = source_k - background_k is the final mesh's offset from the
 /// background layer, D_k = subject_k - background_k the layer offset, S the
 /// slow part of the offset at the head centre (offset_lowpass_hz; it shifts
 /// the whole frame), g the region's blend, a_k
 /// the region's blend at vertex k (g in the core, falling to 0 over the band
-/// by a smoothstep; the band straddles the region's outline), w_k = 1 in the
-/// core and beyond the band and band_data_weight inside the band. S_tri is the similarity residual of
+/// by a smoothstep; the band straddles the region's outline) and w_b the
+/// band's data weight. The core follows the subject layer and the rest of
+/// the frame the background layer exactly; only the band's vertices are
+/// unknowns. S_tri is the similarity residual of
 /// Liu et al.: each triangle's third vertex expressed in the frame of the
 /// other two must keep the relative coordinates it has on the output grid,
 /// so d may translate, rotate and scale locally but not shear. Four
-/// triangles per cell. Linear least squares: a fixed sparse pattern,
-/// factorized per frame (Eigen SimplicialLDLT).
+/// triangles per cell. Linear least squares over the band's vertices
+/// (Eigen SimplicialLDLT per frame; the held vertices enter the right-hand
+/// side).
 ///
 /// Then no undefined pixels: every final vertex must land inside the input
 /// frame (the cells are bilinear, so the whole cell then does); otherwise d
@@ -126,9 +130,10 @@ class LayerBlend {
   std::vector<double> u_, v_;
   LayerBlendOptions options_;
   Eigen::SparseMatrix<double> shape_;  // w_s S^T S
-  Eigen::SparseMatrix<double> system_;
+  Eigen::SparseMatrix<double> system_;  // the band's unknowns only
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver_;
-  bool analyzed_ = false;
+  std::vector<int> free_;  // unknown index of each coordinate, -1 = held
+  std::vector<Eigen::Triplet<double>> triplets_;
   bool has_previous_ = false;
   Eigen::VectorXd d_previous_, e_previous_;
   bool has_slow_ = false, has_smooth_ = false;
