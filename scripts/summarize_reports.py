@@ -33,6 +33,13 @@ def main():
             "%.2f" % gt["cropping"] if gt else "-",
             "%.1f%%" % (100 * gt["undefined_fraction"]) if gt else "-",
             r["throughput_fps"], t["solver"][0], t["total"][0]))
+    if any(m == "steadiface-layered" for _, m, _ in rows):
+        print()
+        print("(steadiface-layered: the bag report maps the head through the subject "
+              "layer and its background point, near the view centre, through the "
+              "background layer; the band, the slow whole-frame shift and the "
+              "subject covering that point are not modelled. The exact figures of "
+              "the layered mesh are steadiface_evaluate's, docs/evaluation.md.)")
     return 0
 
 

@@ -19,8 +19,9 @@
 namespace steadiface {
 namespace {
 
-std::unique_ptr<sim::Simulator> Make(const std::string& preset,
-                                     std::function<void(sim::SimulatorOptions*)> tweak = {}) {
+std::unique_ptr<sim::Simulator> Make(
+    const std::string& preset,
+    std::function<void(sim::SimulatorOptions*)> tweak = {}) {
   sim::SimulatorOptions o;
   o.data_dir = STEADIFACE_TEST_DATA_DIR;
   EXPECT_TRUE(sim::ApplyPreset(preset, &o).ok());
@@ -53,17 +54,20 @@ TEST_P(LayeredScorecardTest, HoldsTheHeadAndTheBackground) {
   const eval::Score gyro = Score(*s, eval::Method::kGyroOnly);
   const eval::Score global = Score(*s, eval::Method::kSteadiface);
   const eval::Score layered = Score(*s, eval::Method::kSteadifaceLayered);
-  std::cout << "[ " << GetParam() << " ] head px: global " << global.head_jitter_px
-            << ", layered " << layered.head_jitter_px << "; visible background px: gyro-only "
+  std::cout << "[ " << GetParam() << " ] head px: global "
+            << global.head_jitter_px << ", layered " << layered.head_jitter_px
+            << "; visible background px: gyro-only "
             << gyro.visible_background_jitter_px << ", global "
             << global.visible_background_jitter_px << ", layered "
             << layered.visible_background_jitter_px << "; cells: worst "
-            << layered.min_cell_ratio << ", p01 " << layered.p01_cell_ratio << ", folded "
-            << layered.folded_cells << "; line deviation " << layered.line_deviation_px
-            << " px (global " << global.line_deviation_px << "); band jitter "
+            << layered.min_cell_ratio << ", p01 " << layered.p01_cell_ratio
+            << ", folded " << layered.folded_cells << "; line deviation "
+            << layered.line_deviation_px << " px (global "
+            << global.line_deviation_px << "); band jitter "
             << layered.band_jitter_px << " px\n";
   EXPECT_LE(layered.head_jitter_px, 1.3 * global.head_jitter_px + 0.02);
-  EXPECT_LE(layered.visible_background_jitter_px, 1.5 * gyro.visible_background_jitter_px + 0.02);
+  EXPECT_LE(layered.visible_background_jitter_px,
+            1.5 * gyro.visible_background_jitter_px + 0.02);
   EXPECT_EQ(layered.folded_cells, 0);
   EXPECT_GE(layered.min_cell_ratio, 0.5);
   EXPECT_EQ(layered.undefined_fraction, 0.0);
@@ -77,7 +81,8 @@ TEST_P(LayeredScorecardTest, HoldsTheHeadAndTheBackground) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, LayeredScorecardTest,
-                         ::testing::Values("walk", "vlog", "pan", "run", "still"));
+                         ::testing::Values("walk", "vlog", "pan", "run",
+                                           "still"));
 
 // When the face is lost (it leaves the frame sideways for about a second)
 // the blend ramps to 0, the output becomes one global warp (exactly the
@@ -99,7 +104,8 @@ TEST(LayeredWarpTest, FaceLossReturnsToOneGlobalWarpWithoutAJump) {
     cv::Mat frame;
     sim::SimTruth truth;
     ASSERT_TRUE(s->Render(i, &frame, &truth).ok());
-    eval::FeedGyroForFrame(*s, truth.stamp, o.imu.imu_time_offset_s, p.get(), &g);
+    eval::FeedGyroForFrame(*s, truth.stamp, o.imu.imu_time_offset_s, p.get(),
+                           &g);
     PipelineFrame f;
     ASSERT_TRUE(p->ProcessFrame(frame, truth.stamp, nullptr, 0.0, &f).ok());
     ASSERT_TRUE(f.layered.active);
@@ -114,9 +120,10 @@ TEST(LayeredWarpTest, FaceLossReturnsToOneGlobalWarpWithoutAJump) {
     }
   }
   const double ramp = o.warp.layered.region.ramp_s;
-  std::cout << "[ face out ] blend: min " << min_blend << ", largest step " << max_step
-            << " (bound " << 1.0 / (s->options().fps * ramp) << "), frames as one global warp "
-            << frames_global << ", last " << last_blend << "\n";
+  std::cout << "[ face out ] blend: min " << min_blend << ", largest step "
+            << max_step << " (bound " << 1.0 / (s->options().fps * ramp)
+            << "), frames as one global warp " << frames_global << ", last "
+            << last_blend << "\n";
   EXPECT_LE(max_step, 1.0 / (s->options().fps * ramp) * (1 + 1e-6));
   EXPECT_EQ(min_blend, 0.0);  // the loss was seen and the warp went global
   EXPECT_GT(frames_global, 5);

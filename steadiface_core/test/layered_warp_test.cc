@@ -28,7 +28,8 @@ struct Grid {
   // The background layer: the output shifted into an 840 x 460 input.
   std::vector<Eigen::Vector2f> Background() const {
     std::vector<Eigen::Vector2f> b(n());
-    for (int k = 0; k < n(); ++k) b[k] = (At(k) + Eigen::Vector2d(100, 50)).cast<float>();
+    for (int k = 0; k < n(); ++k)
+      b[k] = (At(k) + Eigen::Vector2d(100, 50)).cast<float>();
     return b;
   }
 };
@@ -65,10 +66,10 @@ std::vector<Eigen::Vector2f> Shifted(const std::vector<Eigen::Vector2f>& b,
 
 TEST(SubjectRegionTest, SignedDistanceCoversHeadNeckAndShouldersOnly) {
   const SubjectRegion r = Region();
-  EXPECT_LT(r.SignedDistance({320, 150}), -60.0);    // head centre
-  EXPECT_LT(r.SignedDistance({320, 240}), 0.0);      // neck
-  EXPECT_LT(r.SignedDistance({200, 350}), 0.0);      // shoulder
-  EXPECT_GT(r.SignedDistance({100, 100}), 100.0);    // background beside the head
+  EXPECT_LT(r.SignedDistance({320, 150}), -60.0);  // head centre
+  EXPECT_LT(r.SignedDistance({320, 240}), 0.0);    // neck
+  EXPECT_LT(r.SignedDistance({200, 350}), 0.0);    // shoulder
+  EXPECT_GT(r.SignedDistance({100, 100}), 100.0);  // background beside the head
   // Circle-exact: a point 30 px right of the head ellipse's side.
   EXPECT_NEAR(r.SignedDistance({320 + 70 + 30, 150}), 30.0, 1.0);
 }
@@ -90,12 +91,13 @@ TEST(SubjectRegionTest, BlendStartsAtItsTargetThenRampsAtMostDtOverRamp) {
   face.valid = true;
   for (int i = 0; i < 68; ++i) {
     const double a = i <= 16 ? M_PI * i / 16.0 : -0.5 * M_PI + 0.05 * (i - 40);
-    face.landmarks.emplace_back(0.5 + 0.1 * std::cos(a), 0.5 + 0.12 * std::sin(a));
+    face.landmarks.emplace_back(0.5 + 0.1 * std::cos(a),
+                                0.5 + 0.12 * std::sin(a));
   }
   face.landmark_rows.assign(68, 180.0);
   const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
-  const SubjectRegion& first = t.Update(model, out, I, Eigen::Vector2d::Zero(), rows, &face,
-                                        1.0, 0.0);
+  const SubjectRegion& first =
+      t.Update(model, out, I, Eigen::Vector2d::Zero(), rows, &face, 1.0, 0.0);
   ASSERT_TRUE(first.valid);
   EXPECT_DOUBLE_EQ(first.blend, 1.0);  // no previous output to jump from
   // The output shows the middle 70 % of the width, magnified 1/0.7: the jaw
@@ -107,8 +109,8 @@ TEST(SubjectRegionTest, BlendStartsAtItsTargetThenRampsAtMostDtOverRamp) {
   double previous = first.blend;
   int frames = 0;
   while (t.region().blend > 0.0 && frames < 100) {
-    const SubjectRegion& r = t.Update(model, out, I, Eigen::Vector2d::Zero(), rows, nullptr,
-                                      0.0, dt);
+    const SubjectRegion& r = t.Update(model, out, I, Eigen::Vector2d::Zero(),
+                                      rows, nullptr, 0.0, dt);
     EXPECT_LE(previous - r.blend, dt / 0.5 + 1e-12);
     EXPECT_DOUBLE_EQ(r.blend_step, previous - r.blend);
     EXPECT_TRUE(r.valid);  // the last region is kept while it fades
@@ -129,7 +131,8 @@ TEST(LayerBlendTest, CoreFollowsTheSubjectLayerAndTheBackgroundStaysPut) {
   std::vector<Eigen::Vector2f> out;
   LayerBlendReport rep;
   const SubjectRegion region = Region();
-  blend.Blend(Shifted(background, T), background, region, 0.0, 840, 460, &out, &rep);
+  blend.Blend(Shifted(background, T), background, region, 0.0, 840, 460, &out,
+              &rep);
   ASSERT_TRUE(rep.layered);
   const double B = 0.5 * 100, outer = 0.5 * B;
   EXPECT_DOUBLE_EQ(rep.band_px, B);
@@ -205,7 +208,8 @@ TEST(LayerBlendTest, PullsTowardsTheBackgroundInsteadOfLeavingTheFrame) {
   // The background layer exactly fills a 640 x 360 input.
   std::vector<Eigen::Vector2f> background(g.n());
   for (int k = 0; k < g.n(); ++k) background[k] = g.At(k).cast<float>();
-  const auto subject = Shifted(background, Eigen::Vector2d(0.0, 15.0));  // shoulders off the bottom
+  const auto subject = Shifted(
+      background, Eigen::Vector2d(0.0, 15.0));  // shoulders off the bottom
   LayerBlend blend(g.u, g.v, NoSlowShift());
   std::vector<Eigen::Vector2f> out;
   LayerBlendReport rep;
@@ -225,8 +229,8 @@ TEST(LayerBlendTest, BlendZeroIsExactlyTheBackgroundLayer) {
   LayerBlend blend(g.u, g.v, LayerBlendOptions());
   std::vector<Eigen::Vector2f> out;
   LayerBlendReport rep;
-  blend.Blend(Shifted(background, {9, 9}), background, Region(0.0), 1.0 / 30, 840, 460, &out,
-              &rep);
+  blend.Blend(Shifted(background, {9, 9}), background, Region(0.0), 1.0 / 30,
+              840, 460, &out, &rep);
   EXPECT_FALSE(rep.layered);
   for (int k = 0; k < g.n(); ++k) EXPECT_EQ(out[k], background[k]);
 }
@@ -244,13 +248,15 @@ TEST(LayerBlendTest, AHeldOffsetMovesIntoTheWholeFrameShift) {
   blend.Blend(background, background, Region(), 0.0, 840, 460, &out, &rep);
   double first_fast = -1.0;
   for (int i = 0; i < 600; ++i) {
-    blend.Blend(Shifted(background, T), background, Region(), 1.0 / 30, 840, 460, &out, &rep);
+    blend.Blend(Shifted(background, T), background, Region(), 1.0 / 30, 840,
+                460, &out, &rep);
     if (i == 0) first_fast = rep.offset_px;
   }
   EXPECT_NEAR(first_fast, 10.0, 0.5);  // a step is fast: the band takes it
   EXPECT_LT(rep.offset_px, 0.3);
   EXPECT_NEAR(rep.shift_px, 10.0, 0.3);
-  const Eigen::Vector2d far = (out[0] - background[0]).cast<double>();  // a corner
+  const Eigen::Vector2d far =
+      (out[0] - background[0]).cast<double>();  // a corner
   EXPECT_NEAR(far.x(), 10.0, 0.3);
 }
 

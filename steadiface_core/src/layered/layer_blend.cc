@@ -38,19 +38,25 @@ double Excess(const Eigen::Vector2d& p, double w1, double h1) {
 }  // namespace
 
 Status ValidateLayerBlendOptions(const LayerBlendOptions& o) {
-  auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  auto in = [](double v, double lo, double hi) {
+    return std::isfinite(v) && v >= lo && v <= hi;
+  };
   std::ostringstream err;
   if (!in(o.band_width, 0.02, 10.0)) {
-    err << "warp.layered.band_width must be in [0.02, 10] jaw widths, got " << o.band_width;
+    err << "warp.layered.band_width must be in [0.02, 10] jaw widths, got "
+        << o.band_width;
   } else if (!in(o.band_inside, 0.0, 1.0)) {
     err << "warp.layered.band_inside must be in [0, 1], got " << o.band_inside;
   } else if (!in(o.max_offset, 0.0, 10.0)) {
-    err << "warp.layered.max_offset must be in [0, 10] band widths (0 = no cap), got "
+    err << "warp.layered.max_offset must be in [0, 10] band widths (0 = no "
+           "cap), got "
         << o.max_offset;
   } else if (!in(o.offset_lowpass_hz, 0.0, 10.0)) {
-    err << "warp.layered.offset_lowpass_hz must be in [0, 10] Hz (0 = off), got "
+    err << "warp.layered.offset_lowpass_hz must be in [0, 10] Hz (0 = off), "
+           "got "
         << o.offset_lowpass_hz;
-  } else if (!in(o.band_data_weight, 1e-6, 1.0) || !in(o.shape_weight, 0.0, 1e4) ||
+  } else if (!in(o.band_data_weight, 1e-6, 1.0) ||
+             !in(o.shape_weight, 0.0, 1e4) ||
              !in(o.temporal_weight, 0.0, 1e4)) {
     err << "warp.layered: band_data_weight must be in (0, 1], shape_weight and "
            "temporal_weight in [0, 1e4]";
@@ -59,7 +65,8 @@ Status ValidateLayerBlendOptions(const LayerBlendOptions& o) {
   return Status::Ok();
 }
 
-LayerBlend::LayerBlend(const std::vector<double>& u, const std::vector<double>& v,
+LayerBlend::LayerBlend(const std::vector<double>& u,
+                       const std::vector<double>& v,
                        const LayerBlendOptions& options)
     : cols_(static_cast<int>(u.size())),
       rows_(static_cast<int>(v.size())),
@@ -72,10 +79,13 @@ LayerBlend::LayerBlend(const std::vector<double>& u, const std::vector<double>& 
   auto id = [this](int i, int j) { return j * cols_ + i; };
   for (int j = 0; j + 1 < rows_; ++j) {
     for (int i = 0; i + 1 < cols_; ++i) {
-      const int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), e = id(i, j + 1);
-      for (const Triangle& t : {Triangle{a, b, e}, Triangle{b, c, a}, Triangle{c, e, b},
-                                Triangle{e, a, c}}) {
-        auto pos = [this](int k) { return Eigen::Vector2d(u_[k % cols_], v_[k / cols_]); };
+      const int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1),
+                e = id(i, j + 1);
+      for (const Triangle& t : {Triangle{a, b, e}, Triangle{b, c, a},
+                                Triangle{c, e, b}, Triangle{e, a, c}}) {
+        auto pos = [this](int k) {
+          return Eigen::Vector2d(u_[k % cols_], v_[k / cols_]);
+        };
         // V1 - V2 = p (V3 - V2) + q R90 (V3 - V2), R90 (x, y) = (y, -x).
         const Eigen::Vector2d ed = pos(t.v3) - pos(t.v2);
         Eigen::Matrix2d E;
@@ -101,7 +111,8 @@ LayerBlend::LayerBlend(const std::vector<double>& u, const std::vector<double>& 
   }
   Eigen::SparseMatrix<double> S(std::max(row, 1), 2 * n);
   S.setFromTriplets(s.begin(), s.end());
-  shape_ = options_.shape_weight * Eigen::SparseMatrix<double>(S.transpose() * S);
+  shape_ =
+      options_.shape_weight * Eigen::SparseMatrix<double>(S.transpose() * S);
   // Make sure every diagonal entry is in the pattern.
   Eigen::SparseMatrix<double> I(2 * n, 2 * n);
   I.setIdentity();
@@ -114,8 +125,9 @@ LayerBlend::LayerBlend(const std::vector<double>& u, const std::vector<double>& 
 
 void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
                        const std::vector<Eigen::Vector2f>& background,
-                       const SubjectRegion& region, double dt, int input_width, int input_height,
-                       std::vector<Eigen::Vector2f>* source, LayerBlendReport* report) {
+                       const SubjectRegion& region, double dt, int input_width,
+                       int input_height, std::vector<Eigen::Vector2f>* source,
+                       LayerBlendReport* report) {
   const auto start = std::chrono::steady_clock::now();
   const int n = cols_ * rows_;
   LayerBlendReport r;
@@ -141,7 +153,9 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     const int j = rows_ / 2;
     double sum = 0.0, span = 0.0;
     for (int i = 0; i + 1 < cols_; ++i) {
-      sum += (background[j * cols_ + i + 1] - background[j * cols_ + i]).cast<double>().norm();
+      sum += (background[j * cols_ + i + 1] - background[j * cols_ + i])
+                 .cast<double>()
+                 .norm();
       span += u_[i + 1] - u_[i];
     }
     in_per_out = span > 0 ? sum / span : 1.0;
@@ -155,27 +169,32 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   r.band_outer_px = outer;
   std::vector<bool> free_vertex(n);
   for (int k = 0; k < n; ++k) {
-    const double dist = region.SignedDistance(Eigen::Vector2d(u_[k % cols_], v_[k / cols_]));
+    const double dist =
+        region.SignedDistance(Eigen::Vector2d(u_[k % cols_], v_[k / cols_]));
     const double s = std::min(1.0, std::max(0.0, (outer - dist) / B));
     alpha_[k] = region.blend * s * s * (3.0 - 2.0 * s);
     free_vertex[k] = s > 0.0 && s < 1.0;
   }
   // Layer offset at the head centre (bilinear in the vertex grid), its slow
   // part (a shift of the whole frame), and the cap on the rest.
-  Eigen::Vector2d shift = Eigen::Vector2d::Zero(), fast = Eigen::Vector2d::Zero();
+  Eigen::Vector2d shift = Eigen::Vector2d::Zero(),
+                  fast = Eigen::Vector2d::Zero();
   {
     const Eigen::Vector2d h = region.head_centre;
     int i = 0, j = 0;
     while (i + 2 < cols_ && u_[i + 1] < h.x()) ++i;
     while (j + 2 < rows_ && v_[j + 1] < h.y()) ++j;
-    const double a = std::min(1.0, std::max(0.0, (h.x() - u_[i]) / (u_[i + 1] - u_[i])));
-    const double b = std::min(1.0, std::max(0.0, (h.y() - v_[j]) / (v_[j + 1] - v_[j])));
+    const double a =
+        std::min(1.0, std::max(0.0, (h.x() - u_[i]) / (u_[i + 1] - u_[i])));
+    const double b =
+        std::min(1.0, std::max(0.0, (h.y() - v_[j]) / (v_[j + 1] - v_[j])));
     auto D = [&](int ii, int jj) {
       const int k = jj * cols_ + ii;
       return (subject[k] - background[k]).cast<double>().eval();
     };
-    const Eigen::Vector2d Dc = (1 - a) * (1 - b) * D(i, j) + a * (1 - b) * D(i + 1, j) +
-                               (1 - a) * b * D(i, j + 1) + a * b * D(i + 1, j + 1);
+    const Eigen::Vector2d Dc =
+        (1 - a) * (1 - b) * D(i, j) + a * (1 - b) * D(i + 1, j) +
+        (1 - a) * b * D(i, j + 1) + a * b * D(i + 1, j + 1);
     // The slow part of the offset moves the whole frame (a type-2 tracking
     // loop: no lag on ramps such as a pan); the band absorbs the rest.
     const double wn = 2.0 * M_PI * options_.offset_lowpass_hz;
@@ -187,7 +206,8 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
       slow_rate_.setZero();
       has_slow_ = true;
     } else {
-      const double h = std::min(dt, 0.5 / wn);  // keep the loop stable on long gaps
+      const double h =
+          std::min(dt, 0.5 / wn);  // keep the loop stable on long gaps
       const Eigen::Vector2d e = Dc - slow_;
       slow_rate_ += wn * wn * e * h;
       slow_ += (slow_rate_ + 2.0 * wn * e) * h;
@@ -208,7 +228,8 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   }
   double cap = 1.0;
   const double max_offset_px = options_.max_offset * B;
-  if (max_offset_px > 0 && r.offset_px > max_offset_px) cap = max_offset_px / r.offset_px;
+  if (max_offset_px > 0 && r.offset_px > max_offset_px)
+    cap = max_offset_px / r.offset_px;
   r.capped_offset_px = r.offset_px * cap;
   // Targets T_k. Vertices in the core and beyond the band are held at
   // their targets (their data terms dominate: they follow their layer);
@@ -234,7 +255,8 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     triplets_.clear();
     for (int col = 0; col < shape_.outerSize(); ++col) {
       const int fc = free_[col];
-      for (Eigen::SparseMatrix<double>::InnerIterator it(shape_, col); it; ++it) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(shape_, col); it;
+           ++it) {
         const int fr = free_[it.row()];
         if (fr < 0) continue;
         if (fc >= 0) {
@@ -269,7 +291,9 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   auto feasible = [&](double s) {
     for (int k = 0; k < n; ++k) {
       const Eigen::Vector2d bk = background[k].cast<double>();
-      if (Excess(bk + s * d.segment<2>(2 * k), w1, h1) > Excess(bk, w1, h1) + 1e-3) return false;
+      if (Excess(bk + s * d.segment<2>(2 * k), w1, h1) >
+          Excess(bk, w1, h1) + 1e-3)
+        return false;
     }
     return true;
   };
@@ -307,7 +331,8 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   e_previous_ = d - target;
   has_previous_ = true;
   // Distortion of the result.
-  r.folded_cells = CellRatios(cols_, rows_, u_, v_, *source, nullptr, &ratios_scratch_);
+  r.folded_cells =
+      CellRatios(cols_, rows_, u_, v_, *source, nullptr, &ratios_scratch_);
   std::vector<double> sorted = ratios_scratch_;
   if (!sorted.empty()) {
     std::sort(sorted.begin(), sorted.end());
@@ -316,19 +341,23 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   }
   std::vector<double> added;
   CellRatios(cols_, rows_, u_, v_, *source, &background, &added);
-  if (!added.empty()) r.min_added_ratio = *std::min_element(added.begin(), added.end());
-  r.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+  if (!added.empty())
+    r.min_added_ratio = *std::min_element(added.begin(), added.end());
+  r.solve_ms = std::chrono::duration<double, std::milli>(
+                   std::chrono::steady_clock::now() - start)
                    .count();
   *report = r;
 }
 
-int CellRatios(int cols, int rows, const std::vector<double>& u, const std::vector<double>& v,
+int CellRatios(int cols, int rows, const std::vector<double>& u,
+               const std::vector<double>& v,
                const std::vector<Eigen::Vector2f>& source,
-               const std::vector<Eigen::Vector2f>* reference, std::vector<double>* ratio) {
+               const std::vector<Eigen::Vector2f>* reference,
+               std::vector<double>* ratio) {
   ratio->clear();
   int folded = 0;
-  auto jac = [&](const std::vector<Eigen::Vector2f>& m, int i, int j, Eigen::Matrix2d* J,
-                 bool* flipped) {
+  auto jac = [&](const std::vector<Eigen::Vector2f>& m, int i, int j,
+                 Eigen::Matrix2d* J, bool* flipped) {
     const Eigen::Vector2d a = m[j * cols + i].cast<double>();
     const Eigen::Vector2d b = m[j * cols + i + 1].cast<double>();
     const Eigen::Vector2d c = m[(j + 1) * cols + i + 1].cast<double>();

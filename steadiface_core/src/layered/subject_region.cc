@@ -11,12 +11,14 @@ namespace {
 // distance in the unit circle scaled by the smaller half-axis.
 double EllipseDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& c,
                        const Eigen::Vector2d& axes) {
-  const Eigen::Vector2d q((p.x() - c.x()) / axes.x(), (p.y() - c.y()) / axes.y());
+  const Eigen::Vector2d q((p.x() - c.x()) / axes.x(),
+                          (p.y() - c.y()) / axes.y());
   return (q.norm() - 1.0) * std::min(axes.x(), axes.y());
 }
 
 // Signed distance to an axis-aligned box [x0, x1] x [y0, y1].
-double BoxDistance(const Eigen::Vector2d& p, double x0, double x1, double y0, double y1) {
+double BoxDistance(const Eigen::Vector2d& p, double x0, double x1, double y0,
+                   double y1) {
   const double dx = std::max(x0 - p.x(), p.x() - x1);
   const double dy = std::max(y0 - p.y(), p.y() - y1);
   const double outside = std::hypot(std::max(dx, 0.0), std::max(dy, 0.0));
@@ -24,20 +26,27 @@ double BoxDistance(const Eigen::Vector2d& p, double x0, double x1, double y0, do
 }
 
 // 68-point landmark indices (iBUG 300-W): jaw 0-16, chin 8, brows 17-26.
-constexpr int kJawFirst = 0, kJawLast = 16, kChin = 8, kBrowFirst = 17, kBrowLast = 26;
+constexpr int kJawFirst = 0, kJawLast = 16, kChin = 8, kBrowFirst = 17,
+              kBrowLast = 26;
 
 }  // namespace
 
 Status ValidateSubjectRegionOptions(const SubjectRegionOptions& o) {
   std::ostringstream err;
-  auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  auto in = [](double v, double lo, double hi) {
+    return std::isfinite(v) && v >= lo && v <= hi;
+  };
   if (!in(o.head_width_scale, 0.2, 5.0) || !in(o.head_top_scale, 0.0, 3.0)) {
-    err << "warp.layered: head_width_scale must be in [0.2, 5] and head_top_scale in [0, 3]";
-  } else if (!in(o.shoulder_width_scale, 0.2, 10.0) || !in(o.neck_width_scale, 0.05, 5.0)) {
-    err << "warp.layered: shoulder_width_scale must be in [0.2, 10] and neck_width_scale in "
+    err << "warp.layered: head_width_scale must be in [0.2, 5] and "
+           "head_top_scale in [0, 3]";
+  } else if (!in(o.shoulder_width_scale, 0.2, 10.0) ||
+             !in(o.neck_width_scale, 0.05, 5.0)) {
+    err << "warp.layered: shoulder_width_scale must be in [0.2, 10] and "
+           "neck_width_scale in "
            "[0.05, 5]";
   } else if (!in(o.smoothing_s, 0.0, 10.0) || !in(o.ramp_s, 0.01, 60.0)) {
-    err << "warp.layered: region smoothing_s must be in [0, 10] s and ramp_s in [0.01, 60] s";
+    err << "warp.layered: region smoothing_s must be in [0, 10] s and ramp_s "
+           "in [0.01, 60] s";
   }
   if (err.tellp() != 0) return Status::Error(err.str());
   return Status::Ok();
@@ -46,32 +55,35 @@ Status ValidateSubjectRegionOptions(const SubjectRegionOptions& o) {
 double SubjectRegion::SignedDistance(const Eigen::Vector2d& p) const {
   double d = EllipseDistance(p, head_centre, head_axes);
   if (torso) {
-    d = std::min(d, BoxDistance(p, chin.x() - neck_half_width, chin.x() + neck_half_width,
-                                chin.y() - 0.3 * face_height, chin.y() + 1.0 * face_height));
+    d = std::min(
+        d, BoxDistance(p, chin.x() - neck_half_width,
+                       chin.x() + neck_half_width, chin.y() - 0.3 * face_height,
+                       chin.y() + 1.0 * face_height));
     d = std::min(d, EllipseDistance(p, shoulder_centre, shoulder_axes));
   }
   return d;
 }
 
-const SubjectRegion& SubjectRegionTracker::Update(const CameraModel& model,
-                                                  const OutputGeometry& output,
-                                                  const Eigen::Quaterniond& R_v,
-                                                  const Eigen::Vector2d& t,
-                                                  const RowRotations& rows,
-                                                  const FaceObservation* face,
-                                                  double blend_target, double dt) {
+const SubjectRegion& SubjectRegionTracker::Update(
+    const CameraModel& model, const OutputGeometry& output,
+    const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+    const RowRotations& rows, const FaceObservation* face, double blend_target,
+    double dt) {
   const SubjectRegionOptions& o = options_;
   SubjectRegion measured;
-  if (face != nullptr && face->valid && face->landmarks.size() == 68 && !rows.empty()) {
+  if (face != nullptr && face->valid && face->landmarks.size() == 68 &&
+      !rows.empty()) {
     // Landmarks into the output through the subject layer's pose, each at
     // its own row's real rotation.
     std::vector<Eigen::Vector2d> out(68);
     bool ok = true;
     for (int i = 0; i < 68 && ok; ++i) {
-      const double row = face->landmark_rows.size() == 68 ? face->landmark_rows[i]
-                                                           : 0.5 * (rows.height() - 1);
+      const double row = face->landmark_rows.size() == 68
+                             ? face->landmark_rows[i]
+                             : 0.5 * (rows.height() - 1);
       Eigen::Vector2d V;
-      ok = model.Project(face->landmarks[i], R_v, t, rows.At(row), &V) && V.allFinite();
+      ok = model.Project(face->landmarks[i], R_v, t, rows.At(row), &V) &&
+           V.allFinite();
       out[i] = output.VirtualToOutputPixel(V);
     }
     if (ok) {
@@ -80,7 +92,8 @@ const SubjectRegion& SubjectRegionTracker::Update(const CameraModel& model,
         x0 = std::min(x0, out[i].x());
         x1 = std::max(x1, out[i].x());
       }
-      for (int i = kBrowFirst; i <= kBrowLast; ++i) brow = std::min(brow, out[i].y());
+      for (int i = kBrowFirst; i <= kBrowLast; ++i)
+        brow = std::min(brow, out[i].y());
       const Eigen::Vector2d chin = out[kChin];
       const double w = x1 - x0, h = chin.y() - brow;
       if (w > 1.0 && h > 1.0) {
@@ -88,9 +101,12 @@ const SubjectRegion& SubjectRegionTracker::Update(const CameraModel& model,
         measured.jaw_width = w;
         measured.face_height = h;
         measured.chin = chin;
-        const double top = brow - o.head_top_scale * h, bottom = chin.y() + 0.05 * h;
-        measured.head_centre = Eigen::Vector2d(0.5 * (x0 + x1), 0.5 * (top + bottom));
-        measured.head_axes = Eigen::Vector2d(o.head_width_scale * w, 0.5 * (bottom - top));
+        const double top = brow - o.head_top_scale * h,
+                     bottom = chin.y() + 0.05 * h;
+        measured.head_centre =
+            Eigen::Vector2d(0.5 * (x0 + x1), 0.5 * (top + bottom));
+        measured.head_axes =
+            Eigen::Vector2d(o.head_width_scale * w, 0.5 * (bottom - top));
       }
     }
   }
@@ -102,7 +118,9 @@ const SubjectRegion& SubjectRegionTracker::Update(const CameraModel& model,
       r.blend = blend;
     } else {
       // First-order smoothing of the shape parameters (exact for dt).
-      const double a = o.smoothing_s > 0 && dt > 0 ? 1.0 - std::exp(-dt / o.smoothing_s) : 1.0;
+      const double a = o.smoothing_s > 0 && dt > 0
+                           ? 1.0 - std::exp(-dt / o.smoothing_s)
+                           : 1.0;
       r.head_centre += a * (measured.head_centre - r.head_centre);
       r.head_axes += a * (measured.head_axes - r.head_axes);
       r.chin += a * (measured.chin - r.chin);
@@ -113,15 +131,19 @@ const SubjectRegion& SubjectRegionTracker::Update(const CameraModel& model,
   // Neck and shoulders from the smoothed face.
   r.torso = o.torso;
   r.neck_half_width = o.neck_width_scale * r.jaw_width;
-  r.shoulder_axes = Eigen::Vector2d(o.shoulder_width_scale * r.jaw_width, 2.0 * r.face_height);
-  r.shoulder_centre = r.chin + Eigen::Vector2d(0.0, 0.6 * r.face_height + r.shoulder_axes.y());
+  r.shoulder_axes = Eigen::Vector2d(o.shoulder_width_scale * r.jaw_width,
+                                    2.0 * r.face_height);
+  r.shoulder_centre =
+      r.chin + Eigen::Vector2d(0.0, 0.6 * r.face_height + r.shoulder_axes.y());
   // Blend: towards the target (0 without a region), rate-limited.
-  const double target = r.valid ? std::min(1.0, std::max(0.0, blend_target)) : 0.0;
+  const double target =
+      r.valid ? std::min(1.0, std::max(0.0, blend_target)) : 0.0;
   // The stream's first frame starts at its target (as w_f does: there is
   // no previous output to jump from); later frames ramp.
   const double step_max = dt > 0 ? dt / o.ramp_s : 1.0;
   const double previous = r.blend;
-  r.blend = previous + std::min(step_max, std::max(-step_max, target - previous));
+  r.blend =
+      previous + std::min(step_max, std::max(-step_max, target - previous));
   // The first frame's start is not a step (nothing was shown before it).
   r.blend_step = dt > 0 ? std::abs(r.blend - previous) : 0.0;
   return r;

@@ -112,8 +112,9 @@ class LayerBlend {
   /// `input_width/height` bound the sources.
   void Blend(const std::vector<Eigen::Vector2f>& subject,
              const std::vector<Eigen::Vector2f>& background,
-             const SubjectRegion& region, double dt, int input_width, int input_height,
-             std::vector<Eigen::Vector2f>* source, LayerBlendReport* report);
+             const SubjectRegion& region, double dt, int input_width,
+             int input_height, std::vector<Eigen::Vector2f>* source,
+             LayerBlendReport* report);
 
   /// Blend weight a_k of each vertex of the last Blend [0-1].
   const std::vector<double>& vertex_blend() const { return alpha_; }
@@ -129,7 +130,7 @@ class LayerBlend {
   int cols_ = 0, rows_ = 0;
   std::vector<double> u_, v_;
   LayerBlendOptions options_;
-  Eigen::SparseMatrix<double> shape_;  // w_s S^T S
+  Eigen::SparseMatrix<double> shape_;   // w_s S^T S
   Eigen::SparseMatrix<double> system_;  // the band's unknowns only
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver_;
   std::vector<int> free_;  // unknown index of each coordinate, -1 = held
@@ -138,7 +139,8 @@ class LayerBlend {
   Eigen::VectorXd d_previous_, e_previous_;
   bool has_slow_ = false, has_smooth_ = false;
   Eigen::Vector2d smooth_ = Eigen::Vector2d::Zero();
-  Eigen::Vector2d slow_ = Eigen::Vector2d::Zero(), slow_rate_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d slow_ = Eigen::Vector2d::Zero(),
+                  slow_rate_ = Eigen::Vector2d::Zero();
   std::vector<double> alpha_;
   std::vector<double> ratios_scratch_;
 };

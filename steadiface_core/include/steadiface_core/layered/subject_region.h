@@ -43,8 +43,8 @@ struct SubjectRegion {
   Eigen::Vector2d head_centre = Eigen::Vector2d::Zero();
   Eigen::Vector2d head_axes = Eigen::Vector2d::Zero();  ///< half-axes [px]
   Eigen::Vector2d chin = Eigen::Vector2d::Zero();
-  double jaw_width = 0.0;   ///< [px]
-  double face_height = 0.0; ///< brow to chin [px]
+  double jaw_width = 0.0;    ///< [px]
+  double face_height = 0.0;  ///< brow to chin [px]
   bool torso = true;
   double neck_half_width = 0.0;
   Eigen::Vector2d shoulder_centre = Eigen::Vector2d::Zero();
@@ -60,8 +60,9 @@ struct SubjectRegion {
 
 /// Builds the subject region from this frame's landmarks, mapped into the
 /// output through the subject layer's pose, smooths it over time and ramps
-/// its blend weight (towards 1 with a usable face, 0 without). While the face is missing the
-/// last region is kept and the blend ramps to 0. Causal; one per stream.
+/// its blend weight (towards 1 with a usable face, 0 without). While the face
+/// is missing the last region is kept and the blend ramps to 0. Causal; one per
+/// stream.
 class SubjectRegionTracker {
  public:
   explicit SubjectRegionTracker(const SubjectRegionOptions& options)
