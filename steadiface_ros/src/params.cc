@@ -376,6 +376,10 @@ void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::WarpMode* mo
   layered->blend.band_inside = c.band_inside;
   layered->blend.max_offset = c.max_offset;
   layered->blend.offset_lowpass_hz = c.offset_lowpass;
+  layered->region.head_width_scale = c.head_width_scale;
+  layered->region.head_top_scale = c.head_top_scale;
+  layered->region.torso = c.torso;
+  layered->region.shoulder_width_scale = c.shoulder_width_scale;
 }
 
 steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptions& o,
@@ -421,6 +425,10 @@ steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptio
   c.band_inside = w.layered.blend.band_inside;
   c.max_offset = w.layered.blend.max_offset;
   c.offset_lowpass = w.layered.blend.offset_lowpass_hz;
+  c.head_width_scale = w.layered.region.head_width_scale;
+  c.head_top_scale = w.layered.region.head_top_scale;
+  c.torso = w.layered.region.torso;
+  c.shoulder_width_scale = w.layered.region.shoulder_width_scale;
   return c;
 }
 

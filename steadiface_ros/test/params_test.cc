@@ -96,11 +96,13 @@ TEST(ParamsTest, ReconfigureSwitchesTheWarpMode) {
   steadiface::SteadifaceConfig c = steadiface::SteadifaceConfig::__getDefault__();
   c.warp_mode = "layered";
   c.band_width = 0.8;
+  c.torso = false;
   steadiface::WarpMode mode = steadiface::WarpMode::kGlobal;
   steadiface::LayeredWarpOptions layered;
   ApplyConfig(c, &mode, &layered);
   EXPECT_EQ(mode, steadiface::WarpMode::kLayered);
   EXPECT_DOUBLE_EQ(layered.blend.band_width, 0.8);
+  EXPECT_FALSE(layered.region.torso);
   c.warp_mode = "sideways";  // not a mode: left as it was
   ApplyConfig(c, &mode, &layered);
   EXPECT_EQ(mode, steadiface::WarpMode::kLayered);

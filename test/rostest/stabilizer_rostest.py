@@ -239,10 +239,50 @@ class StabilizerTest(unittest.TestCase):
         self.assertLess(worst_angle, 1e-6)
         self.assertLess(worst_t, 1e-6)
 
+    def check_layered(self, c, node):
+        """warp/mode layered on the live node: both virtual cameras in TF, the
+        layer figures in `state`, an output image per state, and a
+        dynamic_reconfigure switch back to global within a few frames."""
+        self.assertTrue(wait_for(lambda: len(c.states) >= 40, 60), "fewer than 40 frames stabilized")
+        with c.lock:
+            states = list(c.states)
+            tf = list(c.tf)
+            imgs, infos = list(c.images), list(c.infos)
+        self.assertTrue(all(s.warp_mode == "layered" for s in states))
+        self.assertTrue(all(s.has_background_layer for s in states))
+        blended = [s for s in states if s.layer_blend > 0.5]
+        self.assertGreater(len(blended), 0.5 * len(states), "the subject region was rarely applied")
+        self.assertTrue(all(s.folded_cells == 0 for s in states))
+        self.assertGreaterEqual(min(s.min_cell_ratio for s in states), 0.5)
+        steps = [s.layer_blend_step for s in states]
+        self.assertLessEqual(max(steps), 1.0 / 30 / 0.5 * 1.05, "the blend jumped")
+        children = set(t.child_frame_id for t in tf)
+        self.assertTrue(any(f.endswith("_stabilized") for f in children), children)
+        self.assertTrue(any(f.endswith("_stabilized_background") for f in children), children)
+        self.assertGreater(len(imgs), 30)
+        for (stamp, w, h), info in zip(imgs, infos):
+            self.assertEqual((w, h), (info.width, info.height))
+            self.assertTrue(all(math.isfinite(v) for v in info.K))
+        print("layered: %d states, blend > 0.5 on %d, worst cell %.3f, largest blend step %.4f" % (
+            len(states), len(blended), min(s.min_cell_ratio for s in states), max(steps)))
+        import dynamic_reconfigure.client
+        client = dynamic_reconfigure.client.Client(node, timeout=10)
+        with c.lock:
+            n_before = len(c.states)
+        client.update_configuration({"warp_mode": "global"})
+        ok = wait_for(lambda: any(s.warp_mode == "global" for s in c.states[n_before:]), 20)
+        self.assertTrue(ok, "warp_mode = global did not show in the state topic")
+        with c.lock:
+            first = next(i for i in range(n_before, len(c.states)) if c.states[i].warp_mode == "global")
+        self.assertLessEqual(first - n_before, 10, "the mode switch took more than 10 frames")
+
     def test_stabilizer(self):
         c = Collector(watch_input=not (ARGS.equivalence or ARGS.bag_loop))
         node = ARGS.node
         dnode = node.lstrip("/")  # diagnostic_updater names drop the leading '/'
+        if ARGS.layered:
+            self.check_layered(c, node)
+            return
         if ARGS.equivalence:
             self.check_equivalence(c)
             return
@@ -327,6 +367,7 @@ if __name__ == "__main__":
     p.add_argument("--no-imu", action="store_true")
     p.add_argument("--equivalence", action="store_true")
     p.add_argument("--bag-loop", action="store_true")
+    p.add_argument("--layered", action="store_true")
     p.add_argument("--params", default="")
     p.add_argument("--bag-tool", default="steadiface_bag")
     ARGS, rest = p.parse_known_args(rospy.myargv()[1:])
