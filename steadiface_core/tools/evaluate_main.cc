@@ -46,6 +46,7 @@ int Usage() {
                "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
                "       [--size WxH] [--seed N] [--render] [--crop R]\n"
                "       [--band W] [--band-inside F] [--max-offset C] [--offset-lowpass HZ]\n"
+               "       [--offset-error S] [--readout-error S] (misconfigure the IMU timing)\n"
                "         (the layered warp's warp/layered/* options, for sweeps)\n";
   return 2;
 }
@@ -62,6 +63,9 @@ int main(int argc, char** argv) {
   bool render = false;
   double crop = NAN;  // NaN: the package default
   steadiface::LayerBlendOptions blend;  // --band etc.
+  // Deliberate misconfiguration of the camera-IMU timing [s] (calibration
+  // studies): added to imu/time_offset and camera/readout_time.
+  double offset_error = 0.0, readout_error = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -77,6 +81,8 @@ int main(int argc, char** argv) {
     else if (a == "--seed") seed = std::strtoull(next().c_str(), nullptr, 10);
     else if (a == "--render") render = true;
     else if (a == "--crop") crop = std::atof(next().c_str());
+    else if (a == "--offset-error") offset_error = std::atof(next().c_str());
+    else if (a == "--readout-error") readout_error = std::atof(next().c_str());
     else if (a == "--band") blend.band_width = std::atof(next().c_str());
     else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
     else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
@@ -224,6 +230,8 @@ int main(int argc, char** argv) {
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
         po.warp.layered.blend = blend;
+        po.imu.imu_time_offset_s += offset_error;
+        po.shutter.readout_time_s = std::max(0.0, po.shutter.readout_time_s + readout_error);
         std::unique_ptr<steadiface::eval::Scorecard> card;
         s = steadiface::eval::MakeScorecard(*sim, po, &card);
         steadiface::eval::VideoScorer* vsp = vs.get();
