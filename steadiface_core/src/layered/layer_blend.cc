@@ -142,8 +142,17 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     has_slow_ = false;
     has_smooth_ = false;
     r.solve_ms = 0.0;
+    // The background layer's own cells (one global warp).
+    r.folded_cells =
+        CellRatios(cols_, rows_, u_, v_, *source, nullptr, &ratios_scratch_);
+    if (!ratios_scratch_.empty()) {
+      std::vector<double> sorted = ratios_scratch_;
+      std::sort(sorted.begin(), sorted.end());
+      r.min_cell_ratio = sorted.front();
+      r.p01_cell_ratio =
+          sorted[static_cast<size_t>(0.01 * (sorted.size() - 1))];
+    }
     *report = r;
-    CellRatios(cols_, rows_, u_, v_, *source, nullptr, &ratios_scratch_);
     return;
   }
   r.layered = true;
