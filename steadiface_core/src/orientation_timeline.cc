@@ -14,6 +14,9 @@ Status ValidateOrientationTimelineOptions(
   const double qn = o.R_cam_imu.norm();
   if (!o.R_cam_imu.coeffs().allFinite() || std::abs(qn - 1.0) > 1e-6) {
     err << "imu.R_cam_imu must be a finite unit quaternion, norm=" << qn;
+  } else if (!o.gyro_bias.allFinite() || o.gyro_bias.norm() >= 1.0) {
+    err << "imu.gyro_bias must be finite with |bias| < 1 rad/s, got |bias|="
+        << o.gyro_bias.norm();
   } else if (!std::isfinite(o.imu_time_offset_s) ||
              std::abs(o.imu_time_offset_s) > 1.0) {
     err << "imu.time_offset must be in [-1, 1] s, got " << o.imu_time_offset_s;
@@ -70,7 +73,7 @@ OrientationTimeline::OrientationTimeline(
 SampleResult OrientationTimeline::AddSample(const GyroSample& sample) {
   SampleResult result = SampleResult::kAccepted;
   const Eigen::Vector3d omega =
-      options_.R_cam_imu.normalized() * sample.angular_velocity;
+      options_.R_cam_imu.normalized() * (sample.angular_velocity - options_.gyro_bias);
   const Time t = sample.stamp + time_offset_;
   if (!sample.angular_velocity.allFinite()) {
     result = SampleResult::kNonFinite;

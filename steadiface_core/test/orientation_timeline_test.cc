@@ -74,6 +74,24 @@ double WobbleError(double rate_hz) {
   return worst;
 }
 
+// A configured gyro bias is removed in the IMU frame, before the rotation
+// into the camera frame: a reading of w + b with bias b integrates as w.
+TEST(OrientationTimelineTest, GyroBiasIsSubtractedInTheImuFrame) {
+  OrientationTimelineOptions o;
+  o.R_cam_imu = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  o.gyro_bias = Eigen::Vector3d(0.01, -0.02, 0.005);
+  OrientationTimeline tl(o);
+  const Eigen::Vector3d w_imu(0.3, -0.5, 0.8);
+  for (int i = 0; i <= 400; ++i) {
+    ASSERT_EQ(tl.AddSample({At(i / 200.0), w_imu + o.gyro_bias}), SampleResult::kAccepted);
+  }
+  Eigen::Quaterniond q;
+  ASSERT_EQ(tl.CameraToWorld(At(1.5), &q), QueryResult::kOk);
+  EXPECT_NEAR(AngleBetween(q, ExpSO3(o.R_cam_imu * w_imu * 1.5)), 0.0, 1e-12);
+  o.gyro_bias = Eigen::Vector3d(2.0, 0, 0);
+  EXPECT_FALSE(ValidateOrientationTimelineOptions(o).ok());
+}
+
 TEST(OrientationTimelineTest, SinusoidalRateStaysWithinStatedErrorAt200Hz) {
   // Motion of +-11 deg at 5 Hz and +-6 deg at 7 Hz (peak rate ~7 rad/s,
   // far harsher than hand shake). Stated bound at 200 Hz: 1e-3 rad

@@ -204,6 +204,17 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
     }
   }
   r.Num("imu/time_offset", &po->imu.imu_time_offset_s, -1.0, 1.0);
+  {
+    const Eigen::Vector3d& b0 = po->imu.gyro_bias;
+    std::vector<double> b = {b0.x(), b0.y(), b0.z()};
+    r.Vec("imu/gyro_bias", &b);
+    if (b.size() != 3 || !std::isfinite(b[0]) || !std::isfinite(b[1]) || !std::isfinite(b[2]) ||
+        Eigen::Vector3d(b[0], b[1], b[2]).norm() >= 1.0) {
+      r.Error("parameter 'imu/gyro_bias' must be [bx, by, bz] in rad/s with |bias| < 1");
+    } else {
+      po->imu.gyro_bias = Eigen::Vector3d(b[0], b[1], b[2]);
+    }
+  }
   r.Num("imu/buffer_duration", &po->imu.buffer_duration_s, 0.5, 600.0);
   r.Int("imu/max_samples", &po->imu.max_samples, 16, 10000000);
   r.Num("imu/max_angular_rate", &po->imu.max_angular_rate, 0.1, 1000.0);

@@ -35,10 +35,9 @@ int Usage(std::ostream& os) {
         "  [--plot DIR] [--image TOPIC] [--info TOPIC] [--imu TOPIC] [--params "
         "P.yaml]...\n"
         "  [--no-readout: keep camera/readout_time] [--quiet]\n"
-        "Estimates imu/R_cam_imu, imu/time_offset and camera/readout_time (and "
-        "a gyro\n"
-        "bias, reported) from a recording with a few seconds of hand shake, "
-        "and writes\n"
+        "Estimates imu/R_cam_imu, imu/time_offset, imu/gyro_bias and "
+        "camera/readout_time\n"
+        "from a recording with a few seconds of hand shake, and writes\n"
         "them as an overlay for stabilize.launch params:= and steadiface_bag "
         "--params.\n"
         "--params files (on top of config/default.yaml) give the starting "
@@ -251,7 +250,10 @@ int main(int argc, char** argv) {
     << r.nearest_permutation.z() << ", " << r.nearest_permutation.w() << "]\n"
     << "  time_offset: " << r.time_offset_s << "  # [s] +-"
     << r.time_offset_sigma_s * 1e3 << " ms (coarse " << r.coarse_offset_s
-    << " s)\n";
+    << " s)\n"
+    << "  gyro_bias: [" << r.bias.x() << ", " << r.bias.y() << ", "
+    << r.bias.z() << "]  # [rad/s], IMU axes, +- [" << r.bias_sigma.x() << ", "
+    << r.bias_sigma.y() << ", " << r.bias_sigma.z() << "]\n";
   if (r.readout_determined) {
     y << "camera:\n  readout_time: " << r.readout_s << "  # [s] +-"
       << r.readout_sigma_s * 1e3 << " ms\n";
@@ -259,11 +261,6 @@ int main(int argc, char** argv) {
     y << "# camera/readout_time not determined (" << r.readout_s << " s +-"
       << r.readout_sigma_s * 1e3 << " ms): left as configured\n";
   }
-  y << "# gyro bias [rad/s], IMU axes (not a stabilizer parameter; for "
-       "information): ["
-    << r.bias.x() << ", " << r.bias.y() << ", " << r.bias.z() << "] +- ["
-    << r.bias_sigma.x() << ", " << r.bias_sigma.y() << ", " << r.bias_sigma.z()
-    << "]\n";
   y.close();
   if (!y || std::rename((out + ".part").c_str(), out.c_str()) != 0) {
     std::cerr << "steadiface_calibrate: cannot write '" << out << "'\n";

@@ -25,6 +25,10 @@ struct OrientationTimelineOptions {
   /// Rotation taking IMU-frame vectors into the camera (optical) frame,
   /// omega_cam = R_cam_imu * omega_imu.
   Eigen::Quaterniond R_cam_imu = Eigen::Quaterniond::Identity();
+  /// Constant gyro bias in the IMU frame, subtracted from every reading
+  /// before it is rotated into the camera frame [rad/s]
+  /// (steadiface_calibrate estimates it). |bias| < 1 rad/s.
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();
   /// Added to every IMU stamp to put it on the camera clock [s]:
   /// t_cam = t_imu + imu_time_offset_s.
   double imu_time_offset_s = 0.0;
