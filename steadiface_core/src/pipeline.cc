@@ -148,22 +148,17 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     }
     has_last_stamp_ = true;
     last_stamp_ = stamp;
-    if (!s.ok()) {
-      f.output.release();
-      *out = std::move(f);
-      return s;
-    }
   } else if (options_.render_output) {
     s = warper_->Warp(image, f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows,
                       &f.output);
     f.timings.mesh_ms = warper_->timings().mesh_ms;
     f.timings.maps_ms = warper_->timings().maps_ms;
     f.timings.remap_ms = warper_->timings().remap_ms;
-    if (!s.ok()) {
-      f.output.release();
-      *out = std::move(f);
-      return s;
-    }
+  }
+  if (!s.ok()) {
+    f.output.release();
+    *out = std::move(f);
+    return s;
   }
   f.timings.total_ms = MsSince(t0);
   *out = std::move(f);

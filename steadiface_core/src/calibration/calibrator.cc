@@ -14,17 +14,11 @@
 #include "steadiface_core/calibration/gyro_integral.h"
 #include "steadiface_core/calibration/gyro_video_check.h"
 #include "steadiface_core/lens_distortion.h"
+#include "steadiface_core/percentile.h"
 #include "steadiface_core/so3.h"
 
 namespace steadiface {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
-}
 
 // Fraction of the readout from the stamp to row y: t(y) = stamp +
 // readout * (y / (H - 1) - s) + row_time_offset.
@@ -315,7 +309,7 @@ Status Calibrator::Solve(CalibrationResult* result) {
     Eigen::Matrix3d Q = Kabsch(a, b, use);
     std::vector<double> err(n);
     for (size_t i = 0; i < n; ++i) err[i] = (Q * a[i] - b[i]).norm();
-    const double cut = 3.0 * Median(err) + 1e-9;
+    const double cut = 3.0 * Percentile(err, 0.5) + 1e-9;
     for (size_t i = 0; i < n; ++i) use[i] = err[i] <= cut;
     Q = Kabsch(a, b, use);
     const double mid = shutter_.readout_time_s * (0.5 - s_share);
@@ -362,7 +356,7 @@ Status Calibrator::Solve(CalibrationResult* result) {
   q_map = Eigen::Quaterniond(R0).normalized();
   std::vector<double> frame_dt;
   for (const Pair* p : good) frame_dt.push_back(ToSeconds(p->b - p->a));
-  const double period = Median(frame_dt);
+  const double period = Percentile(frame_dt, 0.5);
   struct Obs {
     const Pair* p;
     size_t i;
@@ -392,7 +386,7 @@ Status Calibrator::Solve(CalibrationResult* result) {
     q0_map = initial_R_;
     std::vector<double> r;
     for (const Obs& ob : obs) r.push_back(residual_of(ob, q0, off0, ro0, b0));
-    res.residual_before_px = Median(r);
+    res.residual_before_px = Percentile(r, 0.5);
   }
   std::vector<bool> keep(obs.size(), true);
   std::unique_ptr<ceres::Problem> problem;
@@ -434,7 +428,7 @@ Status Calibrator::Solve(CalibrationResult* result) {
       ++used;
     }
   }
-  res.residual_after_px = Median(r);
+  res.residual_after_px = Percentile(r, 0.5);
   const double sigma2 = used > 9 ? sq / (2.0 * used - 9.0) : 1.0;
   ceres::Covariance::Options co;
   ceres::Covariance cov(co);

@@ -447,10 +447,8 @@ Score Scorecard::Compute() const {
   sc.visible_background_jitter_px = nvis ? vis / nvis : NAN;
   sc.line_deviation_px = line_dev_;
   sc.line_deviation_frame = line_dev_frame_;
-  if (!cell_ratios_.empty()) {
-    sc.min_cell_ratio = *std::min_element(cell_ratios_.begin(), cell_ratios_.end());
-    sc.p01_cell_ratio = Percentile(cell_ratios_, 0.01);
-  }
+  sc.min_cell_ratio = min_ratio_;
+  if (!cell_ratios_.empty()) sc.p01_cell_ratio = Percentile(cell_ratios_, 0.01);
   sc.folded_cells = folded_;
   sc.min_cell_ratio_frame = min_ratio_frame_;
   double band = 0.0;

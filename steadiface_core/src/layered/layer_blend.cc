@@ -113,10 +113,6 @@ LayerBlend::LayerBlend(const std::vector<double>& u,
   S.setFromTriplets(s.begin(), s.end());
   shape_ =
       options_.shape_weight * Eigen::SparseMatrix<double>(S.transpose() * S);
-  // Make sure every diagonal entry is in the pattern.
-  Eigen::SparseMatrix<double> I(2 * n, 2 * n);
-  I.setIdentity();
-  shape_ = shape_ + 0.0 * I;
   shape_.makeCompressed();
   d_previous_ = Eigen::VectorXd::Zero(2 * n);
   e_previous_ = Eigen::VectorXd::Zero(2 * n);
@@ -143,15 +139,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     has_smooth_ = false;
     r.solve_ms = 0.0;
     // The background layer's own cells (one global warp).
-    r.folded_cells =
-        CellRatios(cols_, rows_, u_, v_, *source, nullptr, &ratios_scratch_);
-    if (!ratios_scratch_.empty()) {
-      std::vector<double> sorted = ratios_scratch_;
-      std::sort(sorted.begin(), sorted.end());
-      r.min_cell_ratio = sorted.front();
-      r.p01_cell_ratio =
-          sorted[static_cast<size_t>(0.01 * (sorted.size() - 1))];
-    }
+    MeasureCells(*source, &r);
     *report = r;
     return;
   }
@@ -340,14 +328,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   e_previous_ = d - target;
   has_previous_ = true;
   // Distortion of the result.
-  r.folded_cells =
-      CellRatios(cols_, rows_, u_, v_, *source, nullptr, &ratios_scratch_);
-  std::vector<double> sorted = ratios_scratch_;
-  if (!sorted.empty()) {
-    std::sort(sorted.begin(), sorted.end());
-    r.min_cell_ratio = sorted.front();
-    r.p01_cell_ratio = sorted[static_cast<size_t>(0.01 * (sorted.size() - 1))];
-  }
+  MeasureCells(*source, &r);
   std::vector<double> added;
   CellRatios(cols_, rows_, u_, v_, *source, &background, &added);
   if (!added.empty())
@@ -356,6 +337,17 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
                    std::chrono::steady_clock::now() - start)
                    .count();
   *report = r;
+}
+
+void LayerBlend::MeasureCells(const std::vector<Eigen::Vector2f>& source,
+                              LayerBlendReport* r) {
+  r->folded_cells =
+      CellRatios(cols_, rows_, u_, v_, source, nullptr, &ratios_scratch_);
+  if (ratios_scratch_.empty()) return;
+  std::vector<double> sorted = ratios_scratch_;
+  std::sort(sorted.begin(), sorted.end());
+  r->min_cell_ratio = sorted.front();
+  r->p01_cell_ratio = sorted[static_cast<size_t>(0.01 * (sorted.size() - 1))];
 }
 
 int CellRatios(int cols, int rows, const std::vector<double>& u,

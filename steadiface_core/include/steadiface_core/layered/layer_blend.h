@@ -127,6 +127,11 @@ class LayerBlend {
   }
 
  private:
+  // Cell ratios of `source` into ratios_scratch_; folds, worst and 1st
+  // percentile into *r.
+  void MeasureCells(const std::vector<Eigen::Vector2f>& source,
+                    LayerBlendReport* r);
+
   int cols_ = 0, rows_ = 0;
   std::vector<double> u_, v_;
   LayerBlendOptions options_;
