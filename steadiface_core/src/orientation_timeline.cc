@@ -141,9 +141,10 @@ size_t OrientationTimeline::Bracket(Time t) const {
   return static_cast<size_t>(std::distance(samples_.begin(), it)) - 1;
 }
 
-QueryResult OrientationTimeline::CameraToWorld(Time t,
+QueryResult OrientationTimeline::CameraToWorld(Time t_cam,
                                                Eigen::Quaterniond* q_wc) const {
   if (samples_.empty()) return QueryResult::kEmpty;
+  const Time t = t_cam - correction_;
   if (t < samples_.front().t) return QueryResult::kBeforeStart;
   const Node& last = samples_.back();
   if (t > last.t) {
@@ -172,9 +173,10 @@ QueryResult OrientationTimeline::RealRotation(Time t,
   return r;
 }
 
-QueryResult OrientationTimeline::AngularVelocity(Time t,
+QueryResult OrientationTimeline::AngularVelocity(Time t_cam,
                                                  Eigen::Vector3d* omega) const {
   if (samples_.empty()) return QueryResult::kEmpty;
+  const Time t = t_cam - correction_;
   if (t < samples_.front().t) return QueryResult::kBeforeStart;
   if (t > samples_.back().t) {
     if (ToSeconds(t - samples_.back().t) > options_.max_extrapolation_s) {
@@ -195,9 +197,10 @@ QueryResult OrientationTimeline::AngularVelocity(Time t,
   return QueryResult::kOk;
 }
 
-bool OrientationTimeline::MeanAngularSpeed(Time t0, Time t1,
+bool OrientationTimeline::MeanAngularSpeed(Time t0_cam, Time t1_cam,
                                            double* mean) const {
-  if (samples_.size() < 2 || t1 <= t0) return false;
+  if (samples_.size() < 2 || t1_cam <= t0_cam) return false;
+  const Time t0 = t0_cam - correction_, t1 = t1_cam - correction_;
   auto it = std::lower_bound(
       samples_.begin(), samples_.end(), t0,
       [](const Node& n, const Time& value) { return n.t < value; });

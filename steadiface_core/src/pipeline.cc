@@ -1,5 +1,6 @@
 #include "steadiface_core/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace steadiface {
@@ -155,6 +156,8 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     f.timings.maps_ms = warper_->timings().maps_ms;
     f.timings.remap_ms = warper_->timings().remap_ms;
   }
+  f.imu_offset_applied_s = timeline_.offset_correction();
+  if (check_ != nullptr && options_.gyro_video_check.apply_offset) ApplyOffsetEstimate(stamp);
   if (!s.ok()) {
     f.output.release();
     *out = std::move(f);
@@ -163,6 +166,23 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   f.timings.total_ms = MsSince(t0);
   *out = std::move(f);
   return Status::Ok();
+}
+
+void Pipeline::ApplyOffsetEstimate(Time stamp) {
+  // The correction follows the check's estimate from the next frame on
+  // (this frame's rows were covered under the old one), rate-limited; it
+  // holds while the check cannot judge or blames the rotation.
+  const GyroVideoCheckOptions& o = options_.gyro_video_check;
+  const double dt = has_check_stamp_ ? ToSeconds(stamp - check_stamp_) : 0.0;
+  has_check_stamp_ = true;
+  check_stamp_ = stamp;
+  const GyroVideoCheckResult& r = check_->result();
+  if (!r.judged || r.rotation_contradicts || !(dt > 0.0)) return;
+  const double target =
+      std::max(-o.offset_range_s, std::min(o.offset_range_s, r.offset_correction_s));
+  const double step = o.apply_rate_s_per_s * std::min(dt, 0.2);
+  const double now = timeline_.offset_correction();
+  timeline_.set_offset_correction(now + std::max(-step, std::min(step, target - now)));
 }
 
 Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
@@ -215,6 +235,8 @@ void Pipeline::Reset() {
   region_->reset();
   warper_->reset();
   has_last_stamp_ = false;
+  // The applied clock offset correction is the hardware's, and stays.
+  has_check_stamp_ = false;
 }
 
 }  // namespace steadiface

@@ -200,6 +200,43 @@ TEST(OrientationTimelineTest, TimeOffsetIsApplied) {
   }
 }
 
+
+TEST(OrientationTimelineTest, OffsetCorrectionActsAsALargerOffset) {
+  // Configured offset 0 while the camera clock leads by 20 ms: a correction
+  // of +20 ms makes every query read what a timeline configured with the
+  // right offset reads (coverage, orientation, rate, mean speed).
+  OrientationTimelineOptions wrong, right;
+  right.imu_time_offset_s = 0.020;
+  OrientationTimeline a(wrong), b(right);
+  const Wobble m;
+  for (int i = 0; i <= 400; ++i) {
+    const GyroSample s{At(i / 200.0), m.Omega(i / 200.0 + 0.020)};
+    a.AddSample(s);
+    b.AddSample(s);
+  }
+  a.set_offset_correction(0.020);
+  EXPECT_DOUBLE_EQ(a.offset_correction(), 0.020);
+  EXPECT_EQ(a.oldest(), b.oldest());
+  EXPECT_EQ(a.newest(), b.newest());
+  EXPECT_FALSE(a.Covers(At(0.01)));
+  EXPECT_TRUE(a.Covers(At(2.02)));
+  Eigen::Quaterniond qa, qb;
+  Eigen::Vector3d wa, wb;
+  for (double t : {0.3, 1.0051, 2.01}) {
+    ASSERT_EQ(a.CameraToWorld(At(t), &qa), QueryResult::kOk);
+    ASSERT_EQ(b.CameraToWorld(At(t), &qb), QueryResult::kOk);
+    EXPECT_LT(AngleBetween(qa, qb), 1e-12);
+    // World frame: the camera at the first sample (t_cam = 20 ms).
+    EXPECT_LT(AngleBetween(qa, m.Q(0.020).conjugate() * m.Q(t)), 1e-3);
+    ASSERT_EQ(a.AngularVelocity(At(t), &wa), QueryResult::kOk);
+    ASSERT_EQ(b.AngularVelocity(At(t), &wb), QueryResult::kOk);
+    EXPECT_LT((wa - wb).norm(), 1e-12);
+  }
+  double ma = 0.0, mb = 0.0;
+  ASSERT_TRUE(a.MeanAngularSpeed(At(0.5), At(0.9), &ma));
+  ASSERT_TRUE(b.MeanAngularSpeed(At(0.5), At(0.9), &mb));
+  EXPECT_DOUBLE_EQ(ma, mb);
+}
 TEST(OrientationTimelineTest, BadSamplesAreRejectedAndCounted) {
   OrientationTimeline tl{OrientationTimelineOptions()};
   const Eigen::Vector3d w(0.1, 0.2, 0.3);

@@ -404,6 +404,7 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   m.suggested_R_cam_imu = ToMsg(c.best_R_cam_imu);
   m.imu_offset_correction_s = c.offset_correction_s;
   m.imu_offset_off = c.offset_off;
+  m.imu_offset_applied_s = pf.imu_offset_applied_s;
   m.face_ms = pf.timings.face_ms;
   m.stabilizer_ms = pf.timings.stabilizer_ms;
   m.warp_ms = pf.timings.mesh_ms + pf.timings.maps_ms + pf.timings.remap_ms;

@@ -335,6 +335,8 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Num("gyro_video_check/min_motion", &c.min_motion_px, 0.0, 1000.0);
   r.Num("gyro_video_check/better_mounting_ratio", &c.better_mounting_ratio, 0.01, 0.99);
   r.Num("gyro_video_check/offset_warn", &c.offset_warn_s, 1e-4, 1.0);
+  r.Bool("gyro_video_check/apply_offset", &c.apply_offset);
+  r.Num("gyro_video_check/apply_rate", &c.apply_rate_s_per_s, 1e-5, 1.0);
   Status st = r.status();
   if (!st.ok()) return st;
   // Cross-field checks of the core (e.g. low < high) with its own messages.

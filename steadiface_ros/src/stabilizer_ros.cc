@@ -373,7 +373,16 @@ void StabilizerRos::DiagGyroVideo(diagnostic_updater::DiagnosticStatusWrapper& s
   s.add("residual with the best axis permutation [px]", c.residual_best_mounting_px);
   s.add("best axis permutation as imu/R_cam_imu [x y z w]", std::string(quat));
   s.add("imu/time_offset correction [ms]", c.offset_correction_s * 1e3);
-  char text[400];
+  s.add("correction applied now [ms]", w.imu_offset_applied_s * 1e3);
+  char text[512];
+  // What the node does about an offset it disagrees with.
+  char applying[160] = "";
+  if (pipeline_options_.gyro_video_check.apply_offset) {
+    std::snprintf(applying, sizeof(applying),
+                  "; applying %+.1f ms now (gyro_video_check/apply_offset, at most %.0f ms/s)",
+                  w.imu_offset_applied_s * 1e3,
+                  pipeline_options_.gyro_video_check.apply_rate_s_per_s * 1e3);
+  }
   if (!pipeline_options_.gyro_video_check.enabled) {
     s.summary(diagnostic_msgs::DiagnosticStatus::OK, "check off (gyro_video_check/enabled)");
   } else if (!c.judged) {
@@ -392,9 +401,9 @@ void StabilizerRos::DiagGyroVideo(diagnostic_updater::DiagnosticStatusWrapper& s
   } else if (c.offset_off) {
     std::snprintf(text, sizeof(text),
                   "imu/time_offset is off by %+.1f ms: the video agrees best with imu/time_offset "
-                  "%+.1f ms (%.4f s)",
+                  "%+.1f ms (%.4f s)%s",
                   c.offset_correction_s * 1e3, c.offset_correction_s * 1e3,
-                  pipeline_options_.imu.imu_time_offset_s + c.offset_correction_s);
+                  pipeline_options_.imu.imu_time_offset_s + c.offset_correction_s, applying);
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN, text);
   } else {
     std::snprintf(text, sizeof(text),

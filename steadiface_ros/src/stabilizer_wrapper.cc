@@ -432,6 +432,7 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
           cv_bridge::CvImage(in_header, sensor_msgs::image_encodings::BGR8, dbg).toImageMsg());
     }
     status_.gyro_video_check = frame.gyro_video_check;
+    status_.imu_offset_applied_s = frame.imu_offset_applied_s;
     status_.face_state = frame.face.state;
     status_.face_failure = steadiface::FaceFailureName(frame.face.failure);
     status_.face_confidence = frame.face.confidence;

@@ -66,7 +66,12 @@ class GyroVideoCheckTest(unittest.TestCase):
                   last.suggested_R_cam_imu.x, last.suggested_R_cam_imu.y,
                   last.suggested_R_cam_imu.z, last.suggested_R_cam_imu.w,
                   last.imu_offset_correction_s * 1e3))
+        applied = [m.imu_offset_applied_s for m in states]
+        print("applied offset correction, every 30th frame [ms]: %s" %
+              " ".join("%.1f" % (a * 1e3) for a in applied[::30]))
         if ARGS.case == "ok":
+            # gyro_video_check/apply_offset (on by default) stays near zero.
+            self.assertLess(max(abs(a) for a in applied), 0.003, "applied drifted")
             self.assertEqual(warns, [], "WARN with the right settings")
             self.assertGreater(len(judged_ok), 0, "the check never judged")
             return
@@ -80,9 +85,18 @@ class GyroVideoCheckTest(unittest.TestCase):
             M = np.array([[0, 1, 0], [1, 0, 0], [0, 0, -1.0]])
             R = quat_to_R(q)
             self.assertLess(np.abs(R - M.T).max(), 1e-6, R)
+            # No offset is applied while the rotation contradicts the video.
+            self.assertEqual(max(abs(a) for a in applied), 0.0)
         else:
             self.assertIn("imu/time_offset", warns[0][1].message)
             self.assertAlmostEqual(last.imu_offset_correction_s, 0.030, delta=0.005)
+            # The node applies it (apply_offset on by default): towards
+            # +30 ms, never beyond it, never faster than apply_rate (5 ms/s).
+            self.assertGreater(applied[-1], 0.010, "the correction was not applied")
+            self.assertLess(max(applied), 0.035)
+            for a, b, ma, mb in zip(applied, applied[1:], states, states[1:]):
+                dt = (mb.header.stamp - ma.header.stamp).to_sec()
+                self.assertLessEqual(abs(b - a), 0.005 * max(dt, 0.0) + 1e-6)
 
 
 if __name__ == "__main__":

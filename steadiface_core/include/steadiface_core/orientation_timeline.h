@@ -133,18 +133,29 @@ class OrientationTimeline {
   bool MeanAngularSpeed(Time t0, Time t1, double* mean) const;
 
   /// Forgets every sample (time jumped backwards, new epoch). The next sample
-  /// starts a new world frame. Counters are kept.
+  /// starts a new world frame. Counters are kept (and so is the offset
+  /// correction).
   void reset();
+
+  /// A correction added to imu_time_offset_s at query time [s]: every query
+  /// at camera time t reads the samples stored for t - correction, as if the
+  /// offset had been configured larger by `correction` (the live offset
+  /// estimate, gyro_video_check/apply_offset). Default 0.
+  void set_offset_correction(double seconds) {
+    correction_ = FromSeconds(seconds);
+  }
+  double offset_correction() const { return ToSeconds(correction_); }
 
   bool empty() const { return samples_.empty(); }
   size_t size() const { return samples_.size(); }
-  /// Camera-clock stamp of the oldest / newest buffered sample.
-  Time oldest() const { return samples_.front().t; }
-  Time newest() const { return samples_.back().t; }
+  /// Camera-clock stamp of the oldest / newest buffered sample (offset
+  /// correction included).
+  Time oldest() const { return samples_.front().t + correction_; }
+  Time newest() const { return samples_.back().t + correction_; }
   /// Whether a query at t would succeed without extrapolation.
   bool Covers(Time t) const {
-    return !samples_.empty() && t >= samples_.front().t &&
-           t <= samples_.back().t;
+    return !samples_.empty() && t - correction_ >= samples_.front().t &&
+           t - correction_ <= samples_.back().t;
   }
 
   const TimelineStats& stats() const { return stats_; }
@@ -164,6 +175,7 @@ class OrientationTimeline {
   const OrientationTimelineOptions options_;
   const Duration time_offset_;
   const Duration buffer_duration_;
+  Duration correction_{0};  // set_offset_correction()
   std::deque<Node> samples_;
   TimelineStats stats_;
 };

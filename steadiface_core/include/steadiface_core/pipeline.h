@@ -79,6 +79,9 @@ struct PipelineFrame {
   PipelineTimings timings;
   /// The gyro-vs-video check over its window (GyroVideoCheck).
   GyroVideoCheckResult gyro_video_check;
+  /// The clock offset correction the timeline applied to this frame, on top
+  /// of imu/time_offset (gyro_video_check/apply_offset; else 0) [s].
+  double imu_offset_applied_s = 0.0;
   /// The layered warp (warp mode layered).
   LayeredFrame layered;
 };
@@ -134,6 +137,7 @@ class Pipeline {
 
  private:
   Pipeline(const CameraModel& model, const PipelineOptions& options);
+  void ApplyOffsetEstimate(Time stamp);
 
   const CameraModel model_;
   PipelineOptions options_;
@@ -146,6 +150,9 @@ class Pipeline {
   std::unique_ptr<SubjectRegionTracker> region_;  // layered mode
   bool has_last_stamp_ = false;
   Time last_stamp_;
+  // gyro_video_check/apply_offset: the previous frame's stamp (rate limit).
+  bool has_check_stamp_ = false;
+  Time check_stamp_;
 };
 
 }  // namespace steadiface

@@ -55,6 +55,9 @@ Status ValidateGyroVideoCheckOptions(const GyroVideoCheckOptions& o) {
         "better_mounting_ratio in (0, 1), "
         "offset_warn > 0");
   }
+  if (!(o.apply_rate_s_per_s > 0.0 && o.apply_rate_s_per_s <= 1.0)) {
+    return Status::Error("gyro_video_check/apply_rate must be in (0, 1] s/s");
+  }
   return Status::Ok();
 }
 
@@ -210,7 +213,11 @@ void GyroVideoCheck::Process(const cv::Mat& image, Time stamp,
 
 void GyroVideoCheck::EvaluateReady(const OrientationTimeline& timeline) {
   // Evaluate the pairs the gyro now covers, offsets included.
-  const Duration range = FromSeconds(options_.offset_range_s);
+  // Offsets are searched around the configured imu/time_offset: a live
+  // correction the timeline applies (apply_offset) is undone here, so the
+  // window's evidence does not depend on it.
+  const Duration range = FromSeconds(options_.offset_range_s) +
+                         FromSeconds(timeline.offset_correction());
   bool added = false;
   while (!pending_.empty() &&
          timeline.Covers(timing_.LastRowTime(pending_.front().b) + range)) {
@@ -223,8 +230,9 @@ void GyroVideoCheck::EvaluateReady(const OrientationTimeline& timeline) {
 
 void GyroVideoCheck::Evaluate(const Pending& p,
                               const OrientationTimeline& timeline) {
+  const Duration correction = FromSeconds(timeline.offset_correction());
   const Duration range = FromSeconds(options_.offset_range_s);
-  if (!timeline.Covers(timing_.FirstRowTime(p.a) - range)) return;
+  if (!timeline.Covers(timing_.FirstRowTime(p.a) - range + correction)) return;
   // Rotations at each row band's centre, per offset hypothesis.
   auto band = [&](double y) {
     return std::min(kBands - 1,
@@ -235,7 +243,8 @@ void GyroVideoCheck::Evaluate(const Pending& p,
     for (int i = 0; i < kBands; ++i) {
       const double yc = (i + 0.5) * k_.height / kBands;
       if (!QuerySucceeded(timeline.RealRotation(
-              timing_.RowTime(stamp, yc) + FromSeconds(offset), &(*R)[i]))) {
+              timing_.RowTime(stamp, yc) + FromSeconds(offset) + correction,
+              &(*R)[i]))) {
         return false;
       }
     }

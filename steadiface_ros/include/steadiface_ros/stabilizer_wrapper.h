@@ -92,6 +92,8 @@ struct WrapperStatus {
   std::string last_error;
   /// The gyro-vs-video check as of the last frame.
   steadiface::GyroVideoCheckResult gyro_video_check;
+  /// The clock offset correction applied on top of imu/time_offset [s].
+  double imu_offset_applied_s = 0.0;
 };
 
 /// The one object behind the nodelet, the node and the offline bag tool: it

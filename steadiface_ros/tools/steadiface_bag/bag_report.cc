@@ -215,7 +215,7 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
        << s.suggested_R_cam_imu.w << "]"
        << ", \"imu_offset_correction_s\": " << s.imu_offset_correction_s
        << ", \"imu_offset_off\": " << (s.imu_offset_off ? "true" : "false")
-       << "}";
+       << ", \"imu_offset_applied_s\": " << s.imu_offset_applied_s << "}";
     check_json = cj.str();
     if (s.imu_rotation_contradicts) {
       std::cerr << "steadiface_bag: WARNING: imu/R_cam_imu contradicts the "
@@ -231,7 +231,10 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
     } else if (s.imu_offset_off) {
       std::cerr << "steadiface_bag: WARNING: imu/time_offset is off by "
                 << s.imu_offset_correction_s * 1e3
-                << " ms (add it to imu/time_offset)\n";
+                << " ms (add it to imu/time_offset; "
+                << s.imu_offset_applied_s * 1e3
+                << " ms was applied by the last frame, "
+                   "gyro_video_check/apply_offset)\n";
     }
   }
   std::ostringstream rep;

@@ -45,6 +45,13 @@ struct GyroVideoCheckOptions {
   double better_mounting_ratio = 0.6;
   /// Offset disagreement that raises the warning [s].
   double offset_warn_s = 0.005;
+  /// Apply the estimate: the pipeline's timeline follows the check's clock
+  /// offset correction (only while the check judges and the configured
+  /// rotation agrees with the video), at most apply_rate_s_per_s fast.
+  bool apply_offset = true;
+  /// How fast the applied correction may move [s per s of stream time]:
+  /// slow enough that a change never shows as a jump in the output.
+  double apply_rate_s_per_s = 0.005;
 };
 
 Status ValidateGyroVideoCheckOptions(const GyroVideoCheckOptions& o);
