@@ -20,11 +20,12 @@ struct Fixture {
   Eigen::Quaterniond R_v;
   Eigen::Vector2d t{0.01, -0.005};
 
-  Fixture(int w, int h, int channels, int threads) {
+  Fixture(int w, int h, int channels, int threads, bool direct = true) {
     CameraModel::Create(IntrinsicsFromHorizontalFov(w, h, 1.2),
                         CameraModelOptions(), &model);
     WarpOptions o;
     o.num_threads = threads;
+    o.direct_sampling = direct;
     Warper::Create(model, o, &warper);
     input.create(h, w, channels == 1 ? CV_8UC1 : CV_8UC3);
     cv::randu(input, cv::Scalar::all(0), cv::Scalar::all(255));
@@ -58,18 +59,26 @@ void BM_Mesh(benchmark::State& state) {
 }
 
 void BM_Maps(benchmark::State& state) {
-  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3), false);
   f.warper->ComputeMesh(f.R_v, f.t, f.rows);
   for (auto _ : state) f.warper->BuildMaps();
 }
 
 void BM_Remap(benchmark::State& state) {
-  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3), false);
   f.warper->ComputeMesh(f.R_v, f.t, f.rows);
   f.warper->BuildMaps();
   for (auto _ : state) f.warper->Remap(f.input, &f.output);
 }
 
+// The warp kernel: the mesh sampled directly (SampleMesh), no maps.
+void BM_DirectSample(benchmark::State& state) {
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  for (auto _ : state) f.warper->Render(f.input, &f.output);
+}
+
+// Mesh + direct sampling (the default).
 void BM_WarpEndToEnd(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
   for (auto _ : state) f.warper->Warp(f.input, f.R_v, f.t, f.rows, &f.output);
@@ -91,6 +100,7 @@ void BM_BareRemapFloor(benchmark::State& state) {
 BENCHMARK(BM_Mesh)->Apply(Args);
 BENCHMARK(BM_Maps)->Apply(Args);
 BENCHMARK(BM_Remap)->Apply(Args);
+BENCHMARK(BM_DirectSample)->Apply(Args);
 BENCHMARK(BM_WarpEndToEnd)->Apply(Args);
 BENCHMARK(BM_BareRemapFloor)->Apply(Args);
 

@@ -142,8 +142,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     f.layered.blend = warper_->blend_report();
     f.timings.mesh_ms = warper_->timings().mesh_ms;
     if (s.ok() && options_.render_output) {
-      warper_->BuildMaps();
-      s = warper_->Remap(image, &f.output);
+      s = warper_->Render(image, &f.output);
       f.timings.maps_ms = warper_->timings().maps_ms;
       f.timings.remap_ms = warper_->timings().remap_ms;
     }

@@ -8,6 +8,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/mesh_sampler.h"
+#include "steadiface_core/mesh_scanline.h"
 #include "steadiface_core/warp_geometry.h"
 
 namespace steadiface {
@@ -18,9 +20,6 @@ double MsSince(std::chrono::steady_clock::time_point start) {
              std::chrono::steady_clock::now() - start)
       .count();
 }
-
-constexpr int kInterBits = 5;  // OpenCV's INTER_BITS
-constexpr int kInterTabSize = 1 << kInterBits;
 
 }  // namespace
 
@@ -203,92 +202,53 @@ void Warper::BuildMaps() {
     map2_.create(H, W, CV_32FC1);
   }
   const WarpMesh& m = mesh_;
-  const int cells_x = m.cols - 1;
   const bool fixed = options_.fixed_point_maps;
   cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
-    std::vector<Eigen::Vector2f> line(m.cols);
+    std::vector<Eigen::Vector2f> line;
     for (int v = range.start; v < range.end; ++v) {
-      // Cell row and weight.
-      int j = 0;
-      while (j + 1 < m.rows - 1 && m.v[j + 1] < v) ++j;
-      const double span_v = m.v[j + 1] - m.v[j];
-      const float b = span_v > 0 ? static_cast<float>((v - m.v[j]) / span_v)
-                                 : 0.0f;
-      const Eigen::Vector2f* top = &m.source[static_cast<size_t>(j) * m.cols];
-      const Eigen::Vector2f* bot = top + m.cols;
-      for (int i = 0; i < m.cols; ++i) line[i] = (1.0f - b) * top[i] + b * bot[i];
       short* out1 = fixed ? map1_.ptr<short>(v) : nullptr;
       ushort* out2 = fixed ? map2_.ptr<ushort>(v) : nullptr;
       float* fx = fixed ? nullptr : map1_.ptr<float>(v);
       float* fy = fixed ? nullptr : map2_.ptr<float>(v);
-      for (int i = 0; i < cells_x; ++i) {
-        const int u0 = static_cast<int>(std::ceil(m.u[i]));
-        const int u1 = i + 1 == cells_x
-                           ? W - 1
-                           : static_cast<int>(std::ceil(m.u[i + 1])) - 1;
-        const double span_u = m.u[i + 1] - m.u[i];
-        const float inv_span = static_cast<float>(span_u > 0 ? 1.0 / span_u : 0.0);
-        const float offset = static_cast<float>(u0 - m.u[i]);
-        const float dx = (line[i + 1].x() - line[i].x()) * inv_span;
-        const float dy = (line[i + 1].y() - line[i].y()) * inv_span;
-        const float x0 = line[i].x() + dx * offset;
-        const float y0 = line[i].y() + dy * offset;
-        if (fixed) {
-          // As cv::convertMaps: 1/32 px fixed point, integer part in map1,
-          // interpolation-table index in map2. Far-out coordinates clamp
-          // (they sample the black border either way).
-          const float s = static_cast<float>(kInterTabSize);
-          constexpr float kClamp = 16000.0f;
-          // One pixel from its 1/32 px coordinates.
-          auto store = [out1, out2](int u, int32_t ix, int32_t iy) {
-            out1[2 * u] = static_cast<short>(ix >> kInterBits);
-            out1[2 * u + 1] = static_cast<short>(iy >> kInterBits);
-            out2[u] = static_cast<ushort>((iy & (kInterTabSize - 1)) * kInterTabSize +
-                                          (ix & (kInterTabSize - 1)));
-          };
-          const float xe = x0 + dx * static_cast<float>(u1 - u0);
-          const float ye = y0 + dy * static_cast<float>(u1 - u0);
-          if (u1 >= u0 && std::abs(x0) < kClamp && std::abs(y0) < kClamp &&
-              std::abs(xe) < kClamp && std::abs(ye) < kClamp) {
-            // Fast path (the whole segment in range, so no clamping): the
-            // 1/32 px coordinates are linear in u, so step them in integer
-            // fixed point (10 more fractional bits; the drift over a cell of
-            // up to 128 px is <= 0.07 of a 1/32 px step): integer adds and
-            // shifts instead of two float roundings per pixel.
-            constexpr int kFrac = 10;
-            const float f = s * static_cast<float>(1 << kFrac);
-            int32_t X = static_cast<int32_t>(std::lround(x0 * f)) + (1 << (kFrac - 1));
-            int32_t Y = static_cast<int32_t>(std::lround(y0 * f)) + (1 << (kFrac - 1));
-            const int32_t DX = static_cast<int32_t>(std::lround(dx * f));
-            const int32_t DY = static_cast<int32_t>(std::lround(dy * f));
-            for (int u = u0; u <= u1; ++u) {
-              store(u, X >> kFrac, Y >> kFrac);
-              X += DX;
-              Y += DY;
-            }
-            continue;
+      // As cv::convertMaps: 1/32 px fixed point, integer part in map1,
+      // interpolation-table index in map2. Far-out coordinates clamp (they
+      // sample the black border either way).
+      auto store = [out1, out2](int u, int32_t ix, int32_t iy) {
+        out1[2 * u] = static_cast<short>(ix >> kInterBits);
+        out1[2 * u + 1] = static_cast<short>(iy >> kInterBits);
+        out2[u] = static_cast<ushort>((iy & (kInterTabSize - 1)) * kInterTabSize +
+                                      (ix & (kInterTabSize - 1)));
+      };
+      ForEachScanSegment(m, W, v, &line, [&](const ScanSegment& seg) {
+        if (!fixed) {
+          for (int u = seg.u0; u <= seg.u1; ++u) {
+            const float k = static_cast<float>(u - seg.u0);
+            fx[u] = seg.x0 + seg.dx * k;
+            fy[u] = seg.y0 + seg.dy * k;
           }
-          for (int u = u0; u <= u1; ++u) {
-            const float k = static_cast<float>(u - u0);
-            const float px = std::min(std::max(x0 + dx * k, -kClamp), kClamp);
-            const float py = std::min(std::max(y0 + dy * k, -kClamp), kClamp);
-            store(u, cvRound(px * s), cvRound(py * s));
+        } else if (seg.stepped) {
+          int32_t X = seg.X, Y = seg.Y;
+          for (int u = seg.u0; u <= seg.u1; ++u) {
+            store(u, X >> kScanFrac, Y >> kScanFrac);
+            X += seg.DX;
+            Y += seg.DY;
           }
         } else {
-          for (int u = u0; u <= u1; ++u) {
-            const float k = static_cast<float>(u - u0);
-            fx[u] = x0 + dx * k;
-            fy[u] = y0 + dy * k;
+          for (int u = seg.u0; u <= seg.u1; ++u) {
+            int32_t X, Y;
+            ClampedScanCoordinates(seg, u, &X, &Y);
+            store(u, X, Y);
           }
         }
-      }
+      });
     }
   });
   timings_.maps_ms = MsSince(start);
 }
 
-Status Warper::Remap(const cv::Mat& input, cv::Mat* output) {
-  const CameraIntrinsics& k = model_.intrinsics();
+namespace {
+
+Status CheckInput(const CameraIntrinsics& k, const cv::Mat& input) {
   if (input.empty() || input.cols != k.width || input.rows != k.height) {
     std::ostringstream err;
     err << "warp: input is " << input.cols << "x" << input.rows
@@ -298,6 +258,29 @@ Status Warper::Remap(const cv::Mat& input, cv::Mat* output) {
   if (input.depth() != CV_8U || input.channels() < 1 || input.channels() > 4) {
     return Status::Error("warp: input must be 8-bit with 1-4 channels");
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status Warper::Render(const cv::Mat& input, cv::Mat* output) {
+  if (!options_.direct_sampling) {
+    BuildMaps();
+    return Remap(input, output);
+  }
+  Status s = CheckInput(model_.intrinsics(), input);
+  if (!s.ok()) return s;
+  if (mesh_.source.empty()) return Status::Error("warp: no mesh computed yet");
+  const auto start = std::chrono::steady_clock::now();
+  SampleMesh(mesh_, input, output_.width(), output_.height(), output);
+  timings_.maps_ms = 0.0;
+  timings_.remap_ms = MsSince(start);
+  return Status::Ok();
+}
+
+Status Warper::Remap(const cv::Mat& input, cv::Mat* output) {
+  Status s = CheckInput(model_.intrinsics(), input);
+  if (!s.ok()) return s;
   if (map1_.empty()) return Status::Error("warp: no maps built yet");
   const auto start = std::chrono::steady_clock::now();
   cv::remap(input, *output, map1_, map2_, cv::INTER_LINEAR,
@@ -311,11 +294,11 @@ Status Warper::Warp(const cv::Mat& input, const Eigen::Quaterniond& R_v,
                     cv::Mat* output) {
   Status s = ComputeMesh(R_v, t, rows);
   if (!s.ok()) return s;
-  BuildMaps();
-  return Remap(input, output);
+  return Render(input, output);
 }
 
-void Warper::FloatMaps(cv::Mat* map_x, cv::Mat* map_y) const {
+void Warper::FloatMaps(cv::Mat* map_x, cv::Mat* map_y) {
+  BuildMaps();
   if (options_.fixed_point_maps) {
     cv::Mat xy;
     cv::convertMaps(map1_, map2_, xy, cv::noArray(), CV_32FC2);

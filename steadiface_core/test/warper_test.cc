@@ -58,6 +58,7 @@ TEST(WarperTest, IdentityPoseGivesTheScaledCentreCrop) {
   WarpOptions o;
   o.output.crop_ratio = 0.1;
   for (bool fixed : {true, false}) {
+    o.direct_sampling = false;
     o.fixed_point_maps = fixed;
     auto w = MakeWarper(m, o);
     const Eigen::Quaterniond R = ExpSO3(Eigen::Vector3d(0.1, 0.2, -0.1));
@@ -420,6 +421,56 @@ TEST(WarperTest, ThreadCountDoesNotChangeOutput) {
   ASSERT_TRUE(MakeWarper(m, o)->Warp(photo, Rv, {0.01, 0}, RowRotations(Rr, 480), &out2).ok());
   EXPECT_EQ(cv::norm(out1, out2, cv::NORM_INF), 0.0);
   cv::setNumThreads(-1);
+}
+
+// Direct sampling (SampleMesh) against cv::remap with the Warper's own
+// fixed-point maps: bit for bit, for 1 to 4 channels, an odd size, rolling
+// shutter, lens distortion and poses that show the black border.
+TEST(WarperTest, DirectSamplingIsRemapBitForBit) {
+  cv::Mat photo = LoadImage("leuvenA.jpg");
+  const OrientationTimeline tl = ShakeTimeline(6.0);
+  RollingShutterOptions rs;
+  rs.readout_time_s = 0.03;
+  int border_frames = 0;
+  for (const cv::Size size : {cv::Size(640, 480), cv::Size(333, 251)}) {
+    cv::Mat bgr;
+    cv::resize(photo, bgr, size, 0, 0, cv::INTER_AREA);
+    std::vector<cv::Mat> inputs(4);
+    cv::cvtColor(bgr, inputs[0], cv::COLOR_BGR2GRAY);
+    cv::Mat two[] = {inputs[0], 255 - inputs[0]};
+    cv::merge(two, 2, inputs[1]);
+    inputs[2] = bgr;
+    cv::cvtColor(bgr, inputs[3], cv::COLOR_BGR2BGRA);
+    for (bool distorted : {false, true}) {
+      CameraIntrinsics k = IntrinsicsFromHorizontalFov(size.width, size.height, 1.2);
+      if (distorted) {
+        k.distortion = DistortionModel::kPlumbBob;
+        k.distortion_coeffs = {-0.2, 0.05, 0.001, -0.0005, 0.0};
+      }
+      const CameraModel m = Model(k);
+      RowRotations rows;
+      RowRotations::Build(tl, RowTiming(rs, size.height), At(0.4), 32, &rows);
+      for (const Eigen::Vector3d& w :
+           {Eigen::Vector3d(0.004, -0.01, 0.003), Eigen::Vector3d(0.05, 0.3, -0.2)}) {
+        const Eigen::Quaterniond Rv = rows.Middle() * ExpSO3(w);
+        WarpOptions direct, maps;
+        maps.direct_sampling = false;
+        auto a = MakeWarper(m, direct);
+        auto b = MakeWarper(m, maps);
+        for (int cn = 1; cn <= 4; ++cn) {
+          cv::Mat out_a, out_b;
+          ASSERT_TRUE(a->Warp(inputs[cn - 1], Rv, {0.01, -0.02}, rows, &out_a).ok());
+          ASSERT_TRUE(b->Warp(inputs[cn - 1], Rv, {0.01, -0.02}, rows, &out_b).ok());
+          ASSERT_EQ(out_a.type(), out_b.type());
+          EXPECT_EQ(cv::norm(out_a, out_b, cv::NORM_INF), 0.0)
+              << size << " distorted " << distorted << " channels " << cn << " pose "
+              << w.transpose();
+          if (cn == 1 && cv::countNonZero(out_a == 0) > 1000) ++border_frames;
+        }
+      }
+    }
+  }
+  EXPECT_GE(border_frames, 2);  // the large pose shows the black border
 }
 
 }  // namespace

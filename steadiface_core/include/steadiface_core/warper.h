@@ -65,8 +65,13 @@ struct WarpOptions {
   /// Rolling-shutter fixed-point iterations per vertex (see
   /// VirtualToRealPixelRS) [count].
   int fixed_point_iterations = 5;
-  /// Use OpenCV's fixed-point maps (CV_16SC2 + CV_16UC1, 1/32 px); faster
-  /// remap. Otherwise CV_32FC1 x 2.
+  /// Render by sampling the mesh directly (SampleMesh: source coordinates
+  /// stepped per mesh cell in fixed point, bilinear in SIMD registers, no
+  /// dense maps); the output is bit-for-bit cv::remap's with the
+  /// fixed-point maps. Otherwise dense maps are built and cv::remap runs.
+  bool direct_sampling = true;
+  /// Dense maps (direct_sampling off): OpenCV's fixed-point maps (CV_16SC2
+  /// + CV_16UC1, 1/32 px; faster remap), otherwise CV_32FC1 x 2.
   bool fixed_point_maps = true;
   /// Worker threads for map building and remap; 0 keeps OpenCV's default.
   /// Note: cv::setNumThreads is process-wide.
@@ -96,7 +101,9 @@ struct WarpMesh {
 /// Per-stage timings of the last Warp() [ms].
 struct WarpTimings {
   double mesh_ms = 0.0;
+  /// Dense maps (0 with direct sampling).
   double maps_ms = 0.0;
+  /// cv::remap, or the direct sampling.
   double remap_ms = 0.0;
 };
 
@@ -134,7 +141,10 @@ class Warper {
   /// Remaps `input` (8-bit, 1-4 channels, the camera model's size) into
   /// `output` with the last maps.
   Status Remap(const cv::Mat& input, cv::Mat* output);
-  /// All three.
+  /// Renders `input` through the last mesh: SampleMesh with
+  /// direct_sampling, else BuildMaps and Remap.
+  Status Render(const cv::Mat& input, cv::Mat* output);
+  /// ComputeMesh and Render.
   Status Warp(const cv::Mat& input, const Eigen::Quaterniond& R_v,
               const Eigen::Vector2d& t, const RowRotations& rows,
               cv::Mat* output);
@@ -150,9 +160,9 @@ class Warper {
   const OutputGeometry& output_geometry() const { return output_; }
   const ProtrusionGeometry& protrusion() const { return protrusion_; }
   const CameraModel& camera_model() const { return model_; }
-  /// Float maps of the last BuildMaps (built on demand when fixed-point maps
-  /// are used); for tests and tools.
-  void FloatMaps(cv::Mat* map_x, cv::Mat* map_y) const;
+  /// Float maps of the last mesh (builds the dense maps; converted when
+  /// fixed-point maps are used); for tests and tools.
+  void FloatMaps(cv::Mat* map_x, cv::Mat* map_y);
 
  private:
   Warper(const CameraModel& model, const WarpOptions& options,
