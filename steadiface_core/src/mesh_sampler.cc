@@ -47,13 +47,13 @@ inline void SamplePixel(const cv::Mat& in, int cn, int32_t X, int32_t Y,
   }
 }
 
-inline uint16_t Load16(const uchar* p) {
-  uint16_t v;
+inline uint64_t Load64(const uchar* p) {
+  uint64_t v;
   std::memcpy(&v, p, sizeof(v));
   return v;
 }
-inline uint64_t Load64(const uchar* p) {
-  uint64_t v;
+inline uint16_t Load16(const uchar* p) {
+  uint16_t v;
   std::memcpy(&v, p, sizeof(v));
   return v;
 }
@@ -131,7 +131,8 @@ inline void Color4(const uchar* base, size_t step, const cv::v_int32x4& X,
   v_store(ix, v_shr<kScanFrac + kInterBits>(X));
   v_store(iy, v_shr<kScanFrac + kInterBits>(Y));
   // One 8-byte read per pixel and row holds both columns: 4 bytes at the
-  // pixel (BGR + the next byte, or BGRA) and 4 at its right neighbour.
+  // pixel (BGR + the next byte, or BGRA) and, CN bytes on, 4 at its right
+  // neighbour. Vectors are built from registers (no store-to-load trip).
   uint64_t t[4], b[4];
   for (int k = 0; k < 4; ++k) {
     const uchar* p = base + static_cast<size_t>(iy[k]) * step + ix[k] * CN;
@@ -216,6 +217,9 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
       const cv::v_int32x4 dx4 = cv::v_setall_s32(4 * seg.DX);
       const cv::v_int32x4 dy4 = cv::v_setall_s32(4 * seg.DY);
       const int n = seg.u1 - seg.u0 + 1;
+      // The whole segment inside: no per-group check.
+      const bool inside =
+          GroupInside(seg.X, seg.Y, seg.DX, seg.DY, n, in.cols - 2, max_iy);
       for (int g = 0; n >= 8 && g < n; g += 8) {
         // The last group overlaps the previous one rather than leave a
         // scalar tail (it rewrites the same values).
@@ -223,7 +227,8 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
         u = seg.u0 + g;
         X = seg.X + g * seg.DX;
         Y = seg.Y + g * seg.DY;
-        if (!GroupInside(X, Y, seg.DX, seg.DY, 8, in.cols - 2, max_iy)) {
+        if (!inside &&
+            !GroupInside(X, Y, seg.DX, seg.DY, 8, in.cols - 2, max_iy)) {
           for (int k = 0; k < 8; ++k) {
             SamplePixel(in, 1, (X + k * seg.DX) >> kScanFrac,
                         (Y + k * seg.DY) >> kScanFrac, out + u + k);
@@ -242,12 +247,14 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
       // neighbour: keep one more column of margin there.
       const int max_ix = cn == 3 ? in.cols - 3 : in.cols - 2;
       const int n = seg.u1 - seg.u0 + 1;
+      const bool inside =
+          GroupInside(seg.X, seg.Y, seg.DX, seg.DY, n, max_ix, max_iy);
       for (int g = 0; n >= 4 && g < n; g += 4) {
         if (g + 4 > n) g = n - 4;  // overlapping last group, as above
         u = seg.u0 + g;
         X = seg.X + g * seg.DX;
         Y = seg.Y + g * seg.DY;
-        if (!GroupInside(X, Y, seg.DX, seg.DY, 4, max_ix, max_iy)) {
+        if (!inside && !GroupInside(X, Y, seg.DX, seg.DY, 4, max_ix, max_iy)) {
           for (int k = 0; k < 4; ++k) {
             SamplePixel(in, cn, (X + k * seg.DX) >> kScanFrac,
                         (Y + k * seg.DY) >> kScanFrac, out + (u + k) * cn);
