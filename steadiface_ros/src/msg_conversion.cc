@@ -368,6 +368,13 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   m.solver_termination = f.solver.termination;
   m.solver_time_ms = f.solver.time_ms;
   m.solver_usable = f.solver.usable;
+  m.face_state = static_cast<uint8_t>(pf.face.state);
+  m.face_failure = steadiface::FaceFailureName(pf.face.failure);
+  m.face_detected = pf.face.detected;
+  m.face_shape_residual = pf.face.shape_residual;
+  m.face_spread_ratio = pf.face.spread_ratio;
+  m.face_jump = pf.face.jump;
+  m.face_appearance = pf.face.appearance;
   m.face_used = f.flags.face_used;
   m.held_face = f.flags.held_face;
   m.solver_failed = f.flags.solver_failed;
@@ -415,6 +422,8 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   };
   for (double* v : {&m.energy_fit, &m.energy_distortion, &m.energy_follow, &m.energy_rotation,
                     &m.energy_translation, &m.energy_protrusion, &m.mean_angular_speed,
+                    &m.face_shape_residual, &m.face_spread_ratio, &m.face_jump,
+                    &m.face_appearance, &m.imu_offset_applied_s,
                     &m.layer_blend, &m.layer_blend_step, &m.band_px, &m.layer_offset_px,
                     &m.layer_offset_capped_px, &m.layer_shift_px, &m.layer_keep,
                     &m.min_cell_ratio}) {

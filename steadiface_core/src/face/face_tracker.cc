@@ -377,7 +377,12 @@ bool FaceTracker::DetectAndFit(const cv::Mat& gray, const cv::Rect& roi,
     const double scale = std::min(1.0, options_.redetect_face_px / near->width);
     max_side = std::max(64, static_cast<int>(std::max(roi.width, roi.height) * scale));
   }
-  const bool ok = detector_->Detect(gray, roi, &faces, max_side).ok();
+  bool ok = detector_->Detect(gray, roi, &faces, max_side).ok();
+  if (ok && faces.empty() && max_side > 0) {
+    // A second scale near the expected face: blur and rolling-shutter skew
+    // defeat the HOG detector at one scale more often than at two.
+    ok = detector_->Detect(gray, roi, &faces, static_cast<int>(max_side * 1.6)).ok();
+  }
   *detect_ms += MsSince(t0);
   if (!ok || faces.empty()) return false;
   const FaceBox* best = &faces.front();  // largest
@@ -483,7 +488,11 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
       info->timings.detect_ms += det_ms;
       info->timings.landmarks_ms += MsSince(t1) - det_ms;
     }
-    if (!ok && state_ == TrackingState::kTracking && in_frame) {
+    // The landmarks fitted where the gyro says the face is: while tracking,
+    // and while recently lost (the lost face is followed with the gyro), so
+    // a face that blur hides from the detector is kept or taken back as
+    // soon as its landmarks pass the checks against the locked face.
+    if (!ok && state_ != TrackingState::kSearching && in_frame) {
       c = Candidate();
       c.box = pbox;
       const auto t1 = Clock::now();

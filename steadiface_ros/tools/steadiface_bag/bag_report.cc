@@ -37,8 +37,11 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
   // Report: what can be measured without ground truth.
   std::vector<double> face_ms, stab_ms, warp_ms, total_ms, solver_ms, iters;
   std::vector<Eigen::Vector2d> c_in, c_out, shake;
+  // Frames without valid landmarks while a face was locked, by reason.
+  std::map<std::string, int> face_losses;
   for (size_t i = 0; i < sink.states.size(); ++i) {
     const auto& s = sink.states[i];
+    if (s.face_state == 2 /* LOST */) ++face_losses[s.face_failure];
     face_ms.push_back(s.face_ms);
     stab_ms.push_back(s.stabilizer_ms);
     warp_ms.push_back(s.warp_ms);
@@ -264,6 +267,13 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       << ",\n  \"undefined_frames\": " << ws.stabilizer.undefined_frames
       << ",\n  \"solver_failures\": " << ws.stabilizer.solver_failures
       << ",\n  \"frames_with_face\": " << ws.stabilizer.frames_with_face
+      << ",\n  \"face_lost_frames_by_reason\": {";
+  bool first_reason = true;
+  for (const auto& kv : face_losses) {
+    rep << (first_reason ? "" : ", ") << "\"" << kv.first << "\": " << kv.second;
+    first_reason = false;
+  }
+  rep << "}"
       << ",\n  \"timings_ms\": {"
       << "\"face\": [" << Percentile(face_ms, 0.5) << ", "
       << Percentile(face_ms, 0.99) << "], "

@@ -29,6 +29,14 @@ struct SimulatorOptions {
   double readout_s = 0.02;
   /// Rows per rendered band (each band is rendered with its own pose).
   int band_rows = 8;
+  /// Exposure time [s]: each row integrates the scene over
+  /// [row time - exposure/2, row time + exposure/2], rendered as
+  /// exposure_samples sub-frames averaged (motion blur). 0: instantaneous.
+  double exposure_s = 0.0;
+  int exposure_samples = 6;
+  /// Render grey (the BGR frame's three channels equal: a monochrome
+  /// sensor's picture, a grayscale portrait).
+  bool grayscale = false;
   uint64_t seed = 1;
   /// Data folder with astronaut.png, building.jpg and gyro/ (test/data).
   std::string data_dir;
@@ -85,7 +93,9 @@ struct SimulatorOptions {
 
 /// Presets: still, walk, pan, run, occlusion, two_faces, turn_away, vlog
 /// (a walking selfie at arm's length, 0.7 m, with head and shoulders in
-/// front of a building: what the layered warp is judged on).
+/// front of a building: what the layered warp is judged on), shake (the
+/// recorded running trace at 3x, grey, 25 ms exposure blur, 30 ms
+/// readout: what the face tracker is judged on under strong shake).
 Status ApplyPreset(const std::string& name, SimulatorOptions* options);
 const std::vector<std::string>& PresetNames();
 
