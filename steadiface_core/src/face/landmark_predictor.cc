@@ -1,8 +1,19 @@
 #include "steadiface_core/face/landmark_predictor.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <mutex>
+#include <sstream>
 
 #include <dlib/image_processing/shape_predictor.h>
 #include <dlib/opencv/cv_image.h>
@@ -22,11 +33,114 @@ struct LandmarkPredictor::Impl {
   unsigned long num_parts() const { return initial_shape.size() / 2; }
 };
 
+namespace {
+
+// The decoded-model cache: plain native-endian arrays behind a header that
+// names the source (canonical path, size, modification time).
+constexpr char kCacheMagic[8] = {'S', 'F', 'L', 'M', 'C', 'A', 'C', '1'};
+
+struct SourceKey {
+  std::string canonical;
+  uint64_t size = 0;
+  int64_t mtime_ns = 0;
+};
+
+bool StatSource(const std::string& path, SourceKey* key) {
+  struct stat st;
+  if (stat(path.c_str(), &st) != 0) return false;
+  char* real = realpath(path.c_str(), nullptr);
+  key->canonical = real != nullptr ? real : path;
+  std::free(real);
+  key->size = static_cast<uint64_t>(st.st_size);
+  key->mtime_ns = static_cast<int64_t>(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec;
+  return true;
+}
+
+std::string CacheFile(const std::string& dir, const SourceKey& key) {
+  std::ostringstream name;
+  name << dir << "/landmarks_" << std::hex << std::hash<std::string>()(key.canonical)
+       << ".sfcache";
+  return name.str();
+}
+
+bool MakeDirs(const std::string& dir) {
+  for (size_t i = 1; i <= dir.size(); ++i) {
+    if (i == dir.size() || dir[i] == '/') {
+      const std::string part = dir.substr(0, i);
+      if (mkdir(part.c_str(), 0755) != 0 && errno != EEXIST) return false;
+    }
+  }
+  return true;
+}
+
+class CacheWriter {
+ public:
+  explicit CacheWriter(std::ostream* out) : out_(out) {}
+  template <class T>
+  void Pod(const T& v) {
+    out_->write(reinterpret_cast<const char*>(&v), sizeof(T));
+  }
+  void Floats(const float* p, uint64_t n) {
+    Pod(n);
+    out_->write(reinterpret_cast<const char*>(p), static_cast<std::streamsize>(n * sizeof(float)));
+  }
+
+ private:
+  std::ostream* out_;
+};
+
+class CacheReader {
+ public:
+  CacheReader(const char* p, size_t n) : p_(p), end_(p + n) {}
+  template <class T>
+  bool Pod(T* v) {
+    if (static_cast<size_t>(end_ - p_) < sizeof(T)) return false;
+    std::memcpy(v, p_, sizeof(T));
+    p_ += sizeof(T);
+    return true;
+  }
+  // A count of elements of `element_bytes` each that must fit in the rest.
+  bool Count(uint64_t* n, size_t element_bytes) {
+    return Pod(n) && *n <= static_cast<uint64_t>(end_ - p_) / std::max<size_t>(1, element_bytes);
+  }
+  bool Floats(float* dst, uint64_t n) {
+    if (static_cast<uint64_t>(end_ - p_) < n * sizeof(float)) return false;
+    std::memcpy(dst, p_, n * sizeof(float));
+    p_ += n * sizeof(float);
+    return true;
+  }
+  bool Bytes(std::string* s, uint64_t n) {
+    if (static_cast<uint64_t>(end_ - p_) < n) return false;
+    s->assign(p_, n);
+    p_ += n;
+    return true;
+  }
+  bool AtEnd() const { return p_ == end_; }
+
+ private:
+  const char* p_;
+  const char* end_;
+};
+
+}  // namespace
+
 LandmarkPredictor::LandmarkPredictor() = default;
 LandmarkPredictor::~LandmarkPredictor() = default;
 
+std::string LandmarkPredictor::DefaultModelCacheDir() {
+  if (const char* d = std::getenv("STEADIFACE_CACHE_DIR")) return d;
+  if (const char* x = std::getenv("XDG_CACHE_HOME")) {
+    if (x[0] != '\0') return std::string(x) + "/steadiface";
+  }
+  if (const char* h = std::getenv("HOME")) {
+    if (h[0] != '\0') return std::string(h) + "/.cache/steadiface";
+  }
+  return "";
+}
+
 Status LandmarkPredictor::Load(const std::string& path,
-                               std::unique_ptr<LandmarkPredictor>* out) {
+                               std::unique_ptr<LandmarkPredictor>* out,
+                               const std::string& cache_dir) {
   const std::string hint =
       " (the default model ships in Debian's libdlib-data package: "
       "apt-get install libdlib-data, or run scripts/install_deps)";
@@ -52,6 +166,144 @@ Status LandmarkPredictor::Load(const std::string& path,
   }
   std::unique_ptr<LandmarkPredictor> p(new LandmarkPredictor);
   auto impl = std::make_shared<Impl>();
+  SourceKey key;
+  const bool cacheable = !cache_dir.empty() && StatSource(path, &key);
+  const std::string cache_file = cacheable ? CacheFile(cache_dir, key) : std::string();
+  // The decoded model from the cache, if it is this model's.
+  auto read_cache = [&](Impl* m) {
+    std::ifstream in(cache_file, std::ios::binary | std::ios::ate);
+    if (!in.good()) return false;
+    const std::streamoff n = in.tellg();
+    if (n <= 0) return false;
+    std::vector<char> buf(static_cast<size_t>(n));
+    in.seekg(0);
+    if (!in.read(buf.data(), n)) return false;
+    CacheReader r(buf.data(), buf.size());
+    char magic[8];
+    uint64_t size = 0, len = 0;
+    int64_t mtime = 0;
+    std::string canonical;
+    for (char& c : magic) {
+      if (!r.Pod(&c)) return false;
+    }
+    if (std::memcmp(magic, kCacheMagic, sizeof(magic)) != 0 || !r.Pod(&size) ||
+        !r.Pod(&mtime) || !r.Count(&len, 1) || !r.Bytes(&canonical, len) ||
+        size != key.size || mtime != key.mtime_ns || canonical != key.canonical) {
+      return false;
+    }
+    uint64_t n_shape = 0, n_cascades = 0;
+    if (!r.Count(&n_shape, sizeof(float)) || n_shape == 0) return false;
+    m->initial_shape.set_size(static_cast<long>(n_shape));
+    if (!r.Floats(&m->initial_shape(0), n_shape)) return false;
+    if (!r.Count(&n_cascades, 8)) return false;
+    m->forests.resize(n_cascades);
+    m->anchor_idx.resize(n_cascades);
+    m->deltas.resize(n_cascades);
+    for (uint64_t c = 0; c < n_cascades; ++c) {
+      uint64_t n_trees = 0;
+      if (!r.Count(&n_trees, 16)) return false;
+      m->forests[c].resize(n_trees);
+      for (auto& tree : m->forests[c]) {
+        uint64_t n_splits = 0, n_leaves = 0;
+        if (!r.Count(&n_splits, 20)) return false;
+        tree.splits.resize(n_splits);
+        for (auto& s : tree.splits) {
+          uint64_t a = 0, b = 0;
+          if (!r.Pod(&a) || !r.Pod(&b) || !r.Pod(&s.thresh)) return false;
+          s.idx1 = a;
+          s.idx2 = b;
+        }
+        if (!r.Count(&n_leaves, 8)) return false;
+        tree.leaf_values.resize(n_leaves);
+        for (auto& leaf : tree.leaf_values) {
+          uint64_t k = 0;
+          if (!r.Count(&k, sizeof(float))) return false;
+          leaf.set_size(static_cast<long>(k));
+          if (k > 0 && !r.Floats(&leaf(0), k)) return false;
+        }
+      }
+      uint64_t n_anchor = 0, n_deltas = 0;
+      if (!r.Count(&n_anchor, 8)) return false;
+      m->anchor_idx[c].resize(n_anchor);
+      for (auto& a : m->anchor_idx[c]) {
+        uint64_t v = 0;
+        if (!r.Pod(&v)) return false;
+        a = v;
+      }
+      if (!r.Count(&n_deltas, 8)) return false;
+      m->deltas[c].resize(n_deltas);
+      for (auto& d : m->deltas[c]) {
+        float x = 0, y = 0;
+        if (!r.Pod(&x) || !r.Pod(&y)) return false;
+        d = dlib::vector<float, 2>(x, y);
+      }
+    }
+    for (char& c : magic) {
+      if (!r.Pod(&c)) return false;
+    }
+    return std::memcmp(magic, kCacheMagic, sizeof(magic)) == 0 && r.AtEnd();
+  };
+  // Writes the cache next to nothing else: a temporary file renamed into
+  // place, so a reader never sees half a file. Failure is silent.
+  auto write_cache = [&](const Impl& m) {
+    if (!MakeDirs(cache_dir)) return;
+    const std::string tmp = cache_file + ".tmp" + std::to_string(getpid());
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      if (!out.good()) return;
+      CacheWriter w(&out);
+      for (char c : kCacheMagic) w.Pod(c);
+      w.Pod(key.size);
+      w.Pod(key.mtime_ns);
+      w.Pod(static_cast<uint64_t>(key.canonical.size()));
+      out.write(key.canonical.data(), static_cast<std::streamsize>(key.canonical.size()));
+      w.Floats(&m.initial_shape(0), static_cast<uint64_t>(m.initial_shape.size()));
+      w.Pod(static_cast<uint64_t>(m.forests.size()));
+      for (size_t c = 0; c < m.forests.size(); ++c) {
+        w.Pod(static_cast<uint64_t>(m.forests[c].size()));
+        for (const auto& tree : m.forests[c]) {
+          w.Pod(static_cast<uint64_t>(tree.splits.size()));
+          for (const auto& s : tree.splits) {
+            w.Pod(static_cast<uint64_t>(s.idx1));
+            w.Pod(static_cast<uint64_t>(s.idx2));
+            w.Pod(s.thresh);
+          }
+          w.Pod(static_cast<uint64_t>(tree.leaf_values.size()));
+          for (const auto& leaf : tree.leaf_values) {
+            w.Floats(leaf.size() > 0 ? &leaf(0) : nullptr, static_cast<uint64_t>(leaf.size()));
+          }
+        }
+        w.Pod(static_cast<uint64_t>(m.anchor_idx[c].size()));
+        for (unsigned long a : m.anchor_idx[c]) w.Pod(static_cast<uint64_t>(a));
+        w.Pod(static_cast<uint64_t>(m.deltas[c].size()));
+        for (const auto& d : m.deltas[c]) {
+          w.Pod(d.x());
+          w.Pod(d.y());
+        }
+      }
+      for (char c : kCacheMagic) w.Pod(c);
+      out.flush();
+      if (!out.good()) {
+        out.close();
+        std::remove(tmp.c_str());
+        return;
+      }
+    }
+    if (std::rename(tmp.c_str(), cache_file.c_str()) != 0) std::remove(tmp.c_str());
+  };
+  if (cacheable && read_cache(impl.get()) && impl->num_parts() == 68 &&
+      !impl->forests.empty() && impl->forests.size() == impl->anchor_idx.size() &&
+      impl->forests.size() == impl->deltas.size()) {
+    p->impl_ = impl;
+    p->from_cache_ = true;
+    {
+      std::lock_guard<std::mutex> lock(cache_mutex);
+      cache[path] = impl;
+    }
+    *out = std::move(p);
+    return Status::Ok();
+  }
+  impl = std::make_shared<Impl>();
   try {
     std::ifstream in(path, std::ios::binary);
     int version = 0;
@@ -79,6 +331,7 @@ Status LandmarkPredictor::Load(const std::string& path,
                          std::to_string(impl->num_parts()) +
                          " points; steadiface needs the 68-point model" + hint);
   }
+  if (cacheable) write_cache(*impl);
   p->impl_ = impl;
   {
     std::lock_guard<std::mutex> lock(cache_mutex);
