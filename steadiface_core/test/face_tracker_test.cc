@@ -13,7 +13,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "steadiface_core/face/head_pose.h"
+#include "steadiface_core/face/face_detector.h"
 #include "steadiface_core/face/landmark_predictor.h"
+#include "steadiface_core/model_cache.h"
 #include "steadiface_core/face/generic_face.h"
 #include "steadiface_core/sim/scene_renderer.h"
 #include "steadiface_core/so3.h"
@@ -537,6 +539,62 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
   }
   std::remove(files[0].c_str());
   rmdir(dir.c_str());
+  rmdir(dir_template);
+}
+
+}  // namespace
+}  // namespace steadiface
+
+namespace steadiface {
+namespace {
+
+// The face detector's cached copy (in the model cache) finds the same faces
+// as dlib's shipped one; a damaged cache file is ignored and rewritten.
+TEST(FaceDetectorTest, CachedDetectorFindsTheSameFaces) {
+  char dir_template[] = "/tmp/steadiface_detcache_test_XXXXXX";
+  ASSERT_NE(mkdtemp(dir_template), nullptr);
+  const char* old = std::getenv("STEADIFACE_CACHE_DIR");
+  const std::string saved = old != nullptr ? old : "";
+  setenv("STEADIFACE_CACHE_DIR", dir_template, 1);
+  cv::Mat grey;
+  cv::cvtColor(LoadImage("astronaut.png"), grey, cv::COLOR_BGR2GRAY);
+  const cv::Rect all(0, 0, grey.cols, grey.rows);
+  auto detect = [&](std::vector<FaceBox>* faces) {
+    std::unique_ptr<FaceDetector> d;
+    ASSERT_TRUE(FaceDetector::Create(FaceDetectorOptions(), &d).ok());
+    ASSERT_TRUE(d->Detect(grey, all, faces).ok());
+  };
+  std::vector<FaceBox> fresh, cached, repaired;
+  detect(&fresh);  // decodes dlib's detector, writes the cache
+  std::vector<cv::String> files;
+  cv::glob(std::string(dir_template) + "/frontal_face_detector_*.sfcache", files, false);
+  ASSERT_EQ(files.size(), 1u);
+  std::string written;
+  ASSERT_TRUE(ReadWholeFile(files[0], &written));
+  detect(&cached);  // reads the cache
+  {
+    std::string damaged = written;
+    damaged[damaged.size() / 2] ^= 0x5a;
+    ASSERT_TRUE(WriteFileAtomically(files[0], damaged));
+  }
+  detect(&repaired);  // ignores the damaged file, rewrites it
+  std::string rewritten;
+  ASSERT_TRUE(ReadWholeFile(files[0], &rewritten));
+  EXPECT_EQ(rewritten, written);
+  ASSERT_FALSE(fresh.empty());
+  for (const auto* other : {&cached, &repaired}) {
+    ASSERT_EQ(other->size(), fresh.size());
+    for (size_t i = 0; i < fresh.size(); ++i) {
+      EXPECT_EQ((*other)[i].rect, fresh[i].rect);
+      EXPECT_EQ((*other)[i].score, fresh[i].score);
+    }
+  }
+  if (old != nullptr) {
+    setenv("STEADIFACE_CACHE_DIR", saved.c_str(), 1);
+  } else {
+    unsetenv("STEADIFACE_CACHE_DIR");
+  }
+  std::remove(files[0].c_str());
   rmdir(dir_template);
 }
 

@@ -19,6 +19,8 @@
 #include <dlib/opencv/cv_image.h>
 #include <dlib/serialize.h>
 
+#include "steadiface_core/model_cache.h"
+
 namespace steadiface {
 
 // The model's parts, read with dlib's own serialization. We run dlib's
@@ -61,16 +63,6 @@ std::string CacheFile(const std::string& dir, const SourceKey& key) {
   name << dir << "/landmarks_" << std::hex << std::hash<std::string>()(key.canonical)
        << ".sfcache";
   return name.str();
-}
-
-bool MakeDirs(const std::string& dir) {
-  for (size_t i = 1; i <= dir.size(); ++i) {
-    if (i == dir.size() || dir[i] == '/') {
-      const std::string part = dir.substr(0, i);
-      if (mkdir(part.c_str(), 0755) != 0 && errno != EEXIST) return false;
-    }
-  }
-  return true;
 }
 
 class CacheWriter {
@@ -128,14 +120,7 @@ LandmarkPredictor::LandmarkPredictor() = default;
 LandmarkPredictor::~LandmarkPredictor() = default;
 
 std::string LandmarkPredictor::DefaultModelCacheDir() {
-  if (const char* d = std::getenv("STEADIFACE_CACHE_DIR")) return d;
-  if (const char* x = std::getenv("XDG_CACHE_HOME")) {
-    if (x[0] != '\0') return std::string(x) + "/steadiface";
-  }
-  if (const char* h = std::getenv("HOME")) {
-    if (h[0] != '\0') return std::string(h) + "/.cache/steadiface";
-  }
-  return "";
+  return steadiface::DefaultModelCacheDir();
 }
 
 Status LandmarkPredictor::Load(const std::string& path,
@@ -171,13 +156,8 @@ Status LandmarkPredictor::Load(const std::string& path,
   const std::string cache_file = cacheable ? CacheFile(cache_dir, key) : std::string();
   // The decoded model from the cache, if it is this model's.
   auto read_cache = [&](Impl* m) {
-    std::ifstream in(cache_file, std::ios::binary | std::ios::ate);
-    if (!in.good()) return false;
-    const std::streamoff n = in.tellg();
-    if (n <= 0) return false;
-    std::vector<char> buf(static_cast<size_t>(n));
-    in.seekg(0);
-    if (!in.read(buf.data(), n)) return false;
+    std::string buf;
+    if (!ReadWholeFile(cache_file, &buf)) return false;
     CacheReader r(buf.data(), buf.size());
     char magic[8];
     uint64_t size = 0, len = 0;
@@ -246,11 +226,9 @@ Status LandmarkPredictor::Load(const std::string& path,
   // Writes the cache next to nothing else: a temporary file renamed into
   // place, so a reader never sees half a file. Failure is silent.
   auto write_cache = [&](const Impl& m) {
-    if (!MakeDirs(cache_dir)) return;
-    const std::string tmp = cache_file + ".tmp" + std::to_string(getpid());
+    if (!MakeCacheDirs(cache_dir)) return;
     {
-      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      if (!out.good()) return;
+      std::ostringstream out;
       CacheWriter w(&out);
       for (char c : kCacheMagic) w.Pod(c);
       w.Pod(key.size);
@@ -282,14 +260,8 @@ Status LandmarkPredictor::Load(const std::string& path,
         }
       }
       for (char c : kCacheMagic) w.Pod(c);
-      out.flush();
-      if (!out.good()) {
-        out.close();
-        std::remove(tmp.c_str());
-        return;
-      }
+      WriteFileAtomically(cache_file, out.str());
     }
-    if (std::rename(tmp.c_str(), cache_file.c_str()) != 0) std::remove(tmp.c_str());
   };
   if (cacheable && read_cache(impl.get()) && impl->num_parts() == 68 &&
       !impl->forests.empty() && impl->forests.size() == impl->anchor_idx.size() &&
