@@ -31,6 +31,7 @@ int Usage() {
   std::cerr << "usage: steadiface_simulate --preset NAME --out FILE.bag [--duration S]\n"
                "  [--size WxH] [--fps F] [--imu-rate HZ] [--seed N] [--mono] [--data DIR]\n"
                "  [--clock-offset S] [--readout S] [--epoch S] [--no-face] [--hfov RAD]\n"
+               "  [--background FILE: the scene's photo, in --data (default building.jpg)]\n"
                "  [--image-topic T] [--info-topic T|none] [--imu-topic T]\n"
                "  [--camera-frame F] [--imu-frame F]\n"
                "  [--compress-images jpeg|png: sensor_msgs/CompressedImage on <image-topic>/compressed]\n"
@@ -38,7 +39,7 @@ int Usage() {
                "   recorded in IMU axes, so the stabilizer needs imu/R_cam_imu = its inverse]\n"
                "  [--calibration-out FILE.yaml: the camera's intrinsics as a camera_calibration\n"
                "   YAML, for camera_info_url]\n"
-               "presets: still walk pan run occlusion two_faces turn_away vlog\n";
+               "presets: still walk pan run occlusion two_faces turn_away vlog shake\n";
   return 2;
 }
 
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
     else if (a == "--fps") o.fps = std::atof(next().c_str());
     else if (a == "--imu-rate") o.imu_rate_hz = std::atof(next().c_str());
     else if (a == "--seed") o.seed = std::strtoull(next().c_str(), nullptr, 10);
+    else if (a == "--background") o.background_photo = next();
     else if (a == "--mono") mono = true;
     else if (a == "--no-face") o.render_face = false;
     else if (a == "--data") data = next();
