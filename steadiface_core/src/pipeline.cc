@@ -1,5 +1,7 @@
 #include "steadiface_core/pipeline.h"
 
+#include "steadiface_core/mesh_sampler.h"
+
 #include <algorithm>
 #include <chrono>
 
@@ -126,6 +128,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   if (!s.ok()) return s;
   // Warp.
   const bool layered = options_.warp.mode == WarpMode::kLayered;
+  const bool render = options_.render_output && !defer_render_;
   f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(
       layered && f.stabilizer.background.valid ? f.stabilizer.background.t : f.stabilizer.t);
   if (layered) {
@@ -141,19 +144,27 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
                                     f.layered.region, dt);
     f.layered.blend = warper_->blend_report();
     f.timings.mesh_ms = warper_->timings().mesh_ms;
-    if (s.ok() && options_.render_output) {
+    if (s.ok() && render) {
       s = warper_->Render(image, &f.output);
       f.timings.maps_ms = warper_->timings().maps_ms;
       f.timings.remap_ms = warper_->timings().remap_ms;
     }
     has_last_stamp_ = true;
     last_stamp_ = stamp;
-  } else if (options_.render_output) {
+  } else if (render) {
     s = warper_->Warp(image, f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows,
                       &f.output);
     f.timings.mesh_ms = warper_->timings().mesh_ms;
     f.timings.maps_ms = warper_->timings().maps_ms;
     f.timings.remap_ms = warper_->timings().remap_ms;
+  } else if (defer_render_) {
+    s = warper_->ComputeMesh(f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows);
+    f.timings.mesh_ms = warper_->timings().mesh_ms;
+  }
+  if (s.ok() && defer_render_) {
+    f.mesh = warper_->mesh();
+    f.output_size = cv::Size(warper_->output_geometry().width(),
+                             warper_->output_geometry().height());
   }
   f.imu_offset_applied_s = timeline_.offset_correction();
   if (check_ != nullptr && options_.gyro_video_check.apply_offset) ApplyOffsetEstimate(stamp);
@@ -165,6 +176,24 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   f.timings.total_ms = MsSince(t0);
   *out = std::move(f);
   return Status::Ok();
+}
+
+Status Pipeline::ProcessFrameDeferred(const cv::Mat& image, Time stamp,
+                                      const std::vector<Eigen::Vector2d>* external,
+                                      double external_confidence, PipelineFrame* out) {
+  defer_render_ = true;
+  const Status s = ProcessFrame(image, stamp, external, external_confidence, out);
+  defer_render_ = false;
+  return s;
+}
+
+void Pipeline::RenderDeferred(const cv::Mat& image, PipelineFrame* frame) {
+  if (frame->mesh.source.empty() || frame->output_size.area() <= 0) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  SampleMesh(frame->mesh, image, frame->output_size.width, frame->output_size.height,
+             &frame->output);
+  frame->timings.maps_ms = 0.0;
+  frame->timings.remap_ms = MsSince(t0);
 }
 
 void Pipeline::ApplyOffsetEstimate(Time stamp) {
@@ -234,7 +263,10 @@ void Pipeline::Reset() {
   region_->reset();
   warper_->reset();
   has_last_stamp_ = false;
-  // The applied clock offset correction is the hardware's, and stays.
+  // A new epoch starts from the configuration: a replayed bag (rosbag play
+  // --loop) reproduces a fresh start exactly; the check finds the offset
+  // again within seconds.
+  timeline_.set_offset_correction(0.0);
   has_check_stamp_ = false;
 }
 

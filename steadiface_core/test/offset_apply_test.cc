@@ -1,4 +1,4 @@
-// gyro_video_check/apply_offset through the whole pipeline, against
+// gyro_video_check/apply_offset (and the deferred render) through the whole pipeline, against
 // simulator ground truth: the node is configured with a clock offset that
 // is wrong by a known amount, and the applied correction must converge to
 // that amount and give back the background steadiness of the right
@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -118,6 +119,67 @@ TEST(OffsetApplyTest, NothingIsAppliedUnderAWrongRotation) {
   const ApplyRun run = RunApply("walk", 6.0, -0.030, true, 3.0, permuted);
   EXPECT_TRUE(run.rotation_contradicted);
   for (double a : run.applied) EXPECT_EQ(a, 0.0);
+}
+
+}  // namespace
+}  // namespace steadiface
+
+namespace steadiface {
+namespace {
+
+// The two-stage pipeline: ProcessFrameDeferred + RenderDeferred (on another
+// thread, while the next frame is processed) gives ProcessFrame's output
+// bit for bit, in global and layered mode.
+TEST(DeferredRenderTest, MatchesTheOneStagePipelineBitForBit) {
+  sim::SimulatorOptions so;
+  ASSERT_TRUE(sim::ApplyPreset("vlog", &so).ok());
+  so.data_dir = STEADIFACE_TEST_DATA_DIR;
+  so.duration_s = 1.0;
+  so.width = 480;
+  so.height = 270;
+  std::unique_ptr<sim::Simulator> sim;
+  ASSERT_TRUE(sim::Simulator::Create(so, &sim).ok());
+  for (WarpMode mode : {WarpMode::kGlobal, WarpMode::kLayered}) {
+    PipelineOptions po = eval::OptionsFor(*sim, eval::Method::kSteadiface);
+    po.warp.mode = mode;
+    po.render_output = true;
+    std::unique_ptr<Pipeline> one, two;
+    ASSERT_TRUE(Pipeline::Create(sim->intrinsics(), po, &one).ok());
+    ASSERT_TRUE(Pipeline::Create(sim->intrinsics(), po, &two).ok());
+    size_t g1 = 0, g2 = 0;
+    std::thread worker;
+    PipelineFrame held;
+    cv::Mat held_image;
+    std::vector<cv::Mat> expected, got;
+    for (int i = 0; i < sim->num_frames(); ++i) {
+      const Time stamp = sim->Truth(i).stamp;
+      eval::FeedGyroForFrame(*sim, stamp, po.imu.imu_time_offset_s, one.get(), &g1);
+      eval::FeedGyroForFrame(*sim, stamp, po.imu.imu_time_offset_s, two.get(), &g2);
+      cv::Mat frame;
+      sim::SimTruth truth;
+      ASSERT_TRUE(sim->Render(i, &frame, &truth).ok());
+      PipelineFrame a, b;
+      ASSERT_TRUE(one->ProcessFrame(frame, stamp, nullptr, 0.0, &a).ok());
+      expected.push_back(a.output);
+      ASSERT_TRUE(two->ProcessFrameDeferred(frame, stamp, nullptr, 0.0, &b).ok());
+      EXPECT_TRUE(b.output.empty());
+      if (worker.joinable()) {
+        worker.join();
+        got.push_back(held.output);
+      }
+      held = std::move(b);
+      held_image = frame;
+      worker = std::thread([&held, &held_image] { Pipeline::RenderDeferred(held_image, &held); });
+    }
+    worker.join();
+    got.push_back(held.output);
+    ASSERT_EQ(got.size(), expected.size());
+    for (size_t i = 0; i < got.size(); ++i) {
+      ASSERT_EQ(got[i].size(), expected[i].size());
+      EXPECT_EQ(cv::norm(got[i], expected[i], cv::NORM_INF), 0.0)
+          << WarpModeName(mode) << " frame " << i;
+    }
+  }
 }
 
 }  // namespace

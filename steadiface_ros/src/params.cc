@@ -161,6 +161,8 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Num("expected_image_rate", &wo->expected_image_rate, 0.0, 1000.0);
   r.Num("expected_imu_rate", &wo->expected_imu_rate, 0.0, 100000.0);
   r.Bool("passthrough_without_imu", &wo->passthrough_without_imu);
+  r.Bool("pipelined", &wo->pipelined);
+  r.Num("pipeline_hold", &wo->pipeline_hold_s, 0.0, 1.0);
   std::string source = po->landmark_source == LandmarkSource::kExternal
                            ? "topic"
                            : po->landmark_source == LandmarkSource::kNone ? "none" : "dlib";

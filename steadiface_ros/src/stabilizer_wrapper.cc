@@ -39,6 +39,17 @@ StabilizerWrapper::StabilizerWrapper(const steadiface::PipelineOptions& pipeline
   }
 }
 
+StabilizerWrapper::~StabilizerWrapper() {
+  if (render_.joinable()) render_.join();
+}
+
+void StabilizerWrapper::FinishHeld() {
+  if (render_.joinable()) render_.join();
+  if (!held_) return;
+  std::unique_ptr<Held> h = std::move(held_);
+  Publish(h->p, h->frame, h->image, h->extrapolated, false, h->started);
+}
+
 void StabilizerWrapper::RequestStabilizerOptions(const steadiface::StabilizerOptions& o) {
   std::lock_guard<std::mutex> lock(options_mutex_);
   requested_options_ = o;
@@ -95,6 +106,7 @@ void StabilizerWrapper::ResetAll(const char* why) {
   ++counters_.time_jumps;
   sink_->Warn("time_jump", std::string("time jumped backwards (") + why +
                                "): resetting gyro timeline, face tracker and stabilizer");
+  FinishHeld();  // the last frame of the old epoch
   if (pipeline_) pipeline_->Reset();
   recent_gyro_.clear();
   queue_.clear();
@@ -164,6 +176,7 @@ void StabilizerWrapper::OnLandmarks(const steadiface::FaceLandmarks& msg) {
 bool StabilizerWrapper::EnsurePipeline(const sensor_msgs::CameraInfo& info,
                                        const std::string& frame_id) {
   if (pipeline_ && SameGeometry(info, pipeline_info_)) return true;
+  FinishHeld();  // published with the pipeline that processed it
   steadiface::CameraIntrinsics k;
   steadiface::Status s = ToCameraIntrinsics(info, &k);
   if (!s.ok()) {
@@ -230,7 +243,10 @@ void StabilizerWrapper::OnImage(const sensor_msgs::ImageConstPtr& image,
 
 void StabilizerWrapper::OnTimer(const ros::Time& now) { Drain(now, false); }
 
-void StabilizerWrapper::Flush() { Drain(ros::Time(), true); }
+void StabilizerWrapper::Flush() {
+  Drain(ros::Time(), true);
+  FinishHeld();
+}
 
 void StabilizerWrapper::Drain(const ros::Time& now, bool flush) {
   while (!queue_.empty()) {
@@ -252,10 +268,19 @@ void StabilizerWrapper::Drain(const ros::Time& now, bool flush) {
     queue_.pop_front();
     Process(item, !covered);
   }
+  // pipelined: a processed frame waits for the next one at most
+  // pipeline_hold (and not at all at the end of input).
+  if (held_ && (flush || (!now.isZero() && now >= held_->p.received &&
+                          (now - held_->p.received).toSec() >=
+                              wrapper_options_.pipeline_hold_s))) {
+    FinishHeld();
+  }
 }
 
 void StabilizerWrapper::Process(const Pending& p, bool late) {
   const ros::Time started = sink_->Now();
+  // Options (and warper rebuilds) apply between frames: the held frame
+  // renders from its own mesh copy, so it is not affected.
   ApplyPendingOptions();
   cv::Mat image;
   steadiface::Status s = ToCvImage(*p.image, &image);
@@ -295,6 +320,7 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
     ++counters_.passthrough;
     sink_->Error("no_imu", "no IMU data: publishing unstabilized frames");
     last_frame_stamp_ = p.image->header.stamp;
+    FinishHeld();  // in order
     Publish(p, frame, image, false, true, started);
     return;
   }
@@ -312,7 +338,10 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   std::vector<Eigen::Vector2d> none;
   const std::vector<Eigen::Vector2d>* ext =
       use_external && last_external_stamp_ == p.image->header.stamp ? &external_landmarks_ : &none;
-  s = pipeline_->ProcessFrame(image, stamp, ext, external_confidence_, &frame);
+  const bool pipelined = wrapper_options_.pipelined;
+  // Pipelined, this runs while the previous frame renders on render_.
+  s = pipelined ? pipeline_->ProcessFrameDeferred(image, stamp, ext, external_confidence_, &frame)
+                : pipeline_->ProcessFrame(image, stamp, ext, external_confidence_, &frame);
   if (!s.ok()) {
     ++(late ? counters_.dropped_no_gyro : counters_.dropped_pipeline_error);
     sink_->Warn(late ? "late_frame" : "pipeline",
@@ -323,7 +352,16 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   }
   if (extrapolated) ++counters_.extrapolated;
   last_frame_stamp_ = p.image->header.stamp;
-  Publish(p, frame, image, extrapolated, false, started);
+  if (!pipelined) {
+    Publish(p, frame, image, extrapolated, false, started);
+    return;
+  }
+  // Publish the previous frame (its rendering overlapped this frame's
+  // processing), then render this one on the worker.
+  FinishHeld();
+  held_.reset(new Held{p, std::move(frame), image, extrapolated, started});
+  Held* h = held_.get();
+  render_ = std::thread([h] { steadiface::Pipeline::RenderDeferred(h->image, &h->frame); });
 }
 
 void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFrame& frame,
@@ -425,7 +463,9 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
                                    &frame.stabilizer, &dbg);
       if (frame.layered.active) {
         const steadiface::OutputGeometry& og = pipeline_->warper().output_geometry();
-        steadiface::DrawLayeredOverlay(pipeline_->warper().mesh(), frame.layered.region,
+        steadiface::DrawLayeredOverlay(frame.mesh.source.empty() ? pipeline_->warper().mesh()
+                                                                 : frame.mesh,
+                                       frame.layered.region,
                                        frame.layered.blend, og.width(), og.height(), &dbg);
       }
       sink_->PublishDebugImage(

@@ -84,6 +84,10 @@ struct PipelineFrame {
   double imu_offset_applied_s = 0.0;
   /// The layered warp (warp mode layered).
   LayeredFrame layered;
+  /// ProcessFrameDeferred: the frame's warp mesh and output size, for
+  /// RenderDeferred (empty otherwise).
+  WarpMesh mesh;
+  cv::Size output_size;
 };
 
 /// The whole per-frame chain for one camera + IMU stream: gyro timeline,
@@ -113,6 +117,18 @@ class Pipeline {
                       const std::vector<Eigen::Vector2d>* external_landmarks,
                       double external_confidence, PipelineFrame* out);
 
+  /// ProcessFrame without the rendering: `out->mesh` and `out->output_size`
+  /// describe the warp, `out->output` stays empty. RenderDeferred renders it
+  /// later, on any thread, while this pipeline goes on with the next frame
+  /// (a two-stage pipeline; the rendering is SampleMesh, bit-for-bit
+  /// ProcessFrame's with direct sampling or fixed-point maps).
+  Status ProcessFrameDeferred(const cv::Mat& image, Time stamp,
+                              const std::vector<Eigen::Vector2d>* external_landmarks,
+                              double external_confidence, PipelineFrame* out);
+  /// Renders a deferred frame's output from its own mesh (touches no
+  /// pipeline state: thread-safe). Sets timings.remap_ms.
+  static void RenderDeferred(const cv::Mat& image, PipelineFrame* frame);
+
   /// Without gyro: the plain centre crop (identity pose), same output size
   /// and intrinsics as stabilized frames; the trajectory is not touched.
   Status Passthrough(const cv::Mat& image, PipelineFrame* out);
@@ -125,7 +141,8 @@ class Pipeline {
   /// background layer's trajectory). Validated; on error nothing changes.
   Status UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered);
 
-  /// Time jumped back: forget gyro, face lock and trajectory.
+  /// Time jumped back: forget gyro, face lock, trajectory and the applied
+  /// clock offset correction (a fresh start).
   void Reset();
 
   const OrientationTimeline& timeline() const { return timeline_; }
@@ -153,6 +170,8 @@ class Pipeline {
   // gyro_video_check/apply_offset: the previous frame's stamp (rate limit).
   bool has_check_stamp_ = false;
   Time check_stamp_;
+  // ProcessFrameDeferred in progress: mesh only, copied into the frame.
+  bool defer_render_ = false;
 };
 
 }  // namespace steadiface

@@ -68,6 +68,16 @@ struct WrapperOptions {
   double expected_imu_rate = 0.0;
   /// Publish frames unstabilized (centre crop) when no gyro is available.
   bool passthrough_without_imu = true;
+  /// Two-stage pipeline: frame n is rendered on a worker thread while frame
+  /// n+1 goes through face, check and stabilizer; frame n is published
+  /// when frame n+1 is done (or after pipeline_hold, or at the end). Uses a
+  /// second core; adds up to one frame of latency. The bag tool turns it on.
+  bool pipelined = false;
+  /// The longest a processed frame waits for the next one before it is
+  /// published anyway (pipelined) [s]. The next frame is processed about a
+  /// frame period plus the readout and the gyro's delay later: a shorter
+  /// hold overlaps frames only when they queue up (the node falls behind).
+  double pipeline_hold_s = 0.1;
 };
 
 /// Loads every option, validating each; errors name the key and its valid

@@ -4,6 +4,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -116,6 +117,8 @@ class StabilizerWrapper {
   StabilizerWrapper(const steadiface::PipelineOptions& pipeline,
                     const WrapperOptions& options, OutputSink* sink,
                     ExtrinsicLookup extrinsic_lookup = {});
+  /// Waits for a frame still rendering (pipelined); publishes nothing more.
+  ~StabilizerWrapper();
 
   void OnImu(const sensor_msgs::Imu& msg);
   void OnImage(const sensor_msgs::ImageConstPtr& image,
@@ -151,6 +154,8 @@ class StabilizerWrapper {
   void Publish(const Pending& p, const steadiface::PipelineFrame& frame,
                const cv::Mat& input, bool extrapolated, bool passthrough,
                const ros::Time& started);
+  // pipelined: waits for the held frame's rendering and publishes it.
+  void FinishHeld();
 
   steadiface::PipelineOptions options_;
   const WrapperOptions wrapper_options_;
@@ -175,6 +180,17 @@ class StabilizerWrapper {
   bool have_last_imu_ = false;
   WrapperCounters counters_;
   WrapperStatus status_;
+
+  // pipelined: the processed frame whose output renders on `render_`.
+  struct Held {
+    Pending p;
+    steadiface::PipelineFrame frame;
+    cv::Mat image;
+    bool extrapolated = false;
+    ros::Time started;
+  };
+  std::unique_ptr<Held> held_;
+  std::thread render_;
 
   std::mutex options_mutex_;
   bool options_pending_ = false;

@@ -47,7 +47,7 @@ struct Args {
   steadiface_bag::BagTopics topics;
   std::string compress = "none";
   bool debug_overlay = false, debug_images_in_bag = false, gyro_only = false,
-       quiet = false;
+       quiet = false, no_pipeline = false;
   double start_stamp = 0.0;  // images before this stamp are skipped
   std::string
       only_stamps;  // file of image stamps [s] to process; others skipped
@@ -64,6 +64,9 @@ int Usage() {
          "OUT.bag]\n"
          "  [--video OUT.mp4] [--debug-overlay] [--report OUT.json]\n"
          "  [--trajectory OUT.csv] [--gyro-only] [--quiet]\n"
+         "  [--no-pipeline: render each frame before processing the next (by "
+         "default\n"
+         "   frame n renders on a second thread while frame n+1 is processed)]\n"
          "  [--truth IN.bag.truth.csv (default: found beside the bag)]\n"
          "  [--plots DIR --name NAME: trajectories for "
          "scripts/plot_report.py]\n"
@@ -119,6 +122,8 @@ int main(int argc, char** argv) {
       a.trajectory = next();
     else if (s == "--gyro-only")
       a.gyro_only = true;
+    else if (s == "--no-pipeline")
+      a.no_pipeline = true;
     else if (s == "--quiet")
       a.quiet = true;
     else if (s == "--truth")
@@ -157,6 +162,10 @@ int main(int argc, char** argv) {
     std::cerr << "steadiface_bag: " << st.message() << "\n";
     return 1;
   }
+  // Offline, throughput counts and latency does not: render each frame on
+  // a second thread while the next one is processed (same output).
+  wo.pipelined = !a.no_pipeline;
+  wo.pipeline_hold_s = 1.0;  // bag time: the next frame's gyro comes later
   if (a.gyro_only) {
     po.stabilizer.gyro_only = true;
     po.landmark_source = steadiface::LandmarkSource::kNone;
