@@ -1,9 +1,9 @@
 #include "steadiface_core/pipeline.h"
 
-#include "steadiface_core/mesh_sampler.h"
-
 #include <algorithm>
 #include <chrono>
+
+#include "steadiface_core/mesh_sampler.h"
 
 namespace steadiface {
 namespace {
