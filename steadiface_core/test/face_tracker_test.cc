@@ -1,21 +1,12 @@
 #include "steadiface_core/face/face_tracker.h"
 
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <iostream>
 
 #include <gtest/gtest.h>
-#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "steadiface_core/face/head_pose.h"
-#include "steadiface_core/face/face_detector.h"
-#include "steadiface_core/face/landmark_predictor.h"
-#include "steadiface_core/model_cache.h"
 #include "steadiface_core/face/generic_face.h"
 #include "steadiface_core/sim/scene_renderer.h"
 #include "steadiface_core/so3.h"
@@ -470,132 +461,6 @@ TEST(HeadPoseTest, RecoversKnownRotationsOfTheGenericFace) {
     EXPECT_NEAR(pitch, ypr[1], 0.02);
     EXPECT_NEAR(roll, ypr[2], 0.02);
   }
-}
-
-}  // namespace
-}  // namespace steadiface
-
-namespace steadiface {
-namespace {
-
-// The decoded-model cache gives the very same model: identical landmarks
-// to the last bit on a real photo; a damaged cache file is ignored and
-// rewritten.
-TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
-  char dir_template[] = "/tmp/steadiface_cache_test_XXXXXX";
-  ASSERT_NE(mkdtemp(dir_template), nullptr);
-  const std::string dir = std::string(dir_template) + "/nested";
-  cv::Mat grey;
-  cv::cvtColor(LoadImage("astronaut.png"), grey, cv::COLOR_BGR2GRAY);
-  const cv::Rect2d box(139, 38, 168, 188);  // the face in astronaut.png
-  std::vector<Eigen::Vector2d> reference, cached;
-  {
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "").ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-    ASSERT_TRUE(p->Predict(grey, box, &reference).ok());
-  }
-  {
-    std::unique_ptr<LandmarkPredictor> p;  // decodes the .dat, writes the cache
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-  }
-  {
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_TRUE(p->loaded_from_cache());
-    ASSERT_TRUE(p->Predict(grey, box, &cached).ok());
-  }
-  ASSERT_EQ(cached.size(), reference.size());
-  for (size_t i = 0; i < cached.size(); ++i) {
-    EXPECT_EQ(cached[i].x(), reference[i].x()) << i;
-    EXPECT_EQ(cached[i].y(), reference[i].y()) << i;
-  }
-  // Damage the cache (cut it in half): ignored, and rewritten.
-  std::vector<cv::String> files;
-  cv::glob(dir + "/*.sfcache", files, false);
-  ASSERT_EQ(files.size(), 1u);
-  struct stat st;
-  ASSERT_EQ(stat(files[0].c_str(), &st), 0);
-  const off_t full_size = st.st_size;
-  ASSERT_EQ(truncate(files[0].c_str(), full_size / 2), 0);
-  {
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-  }
-  ASSERT_EQ(stat(files[0].c_str(), &st), 0);
-  EXPECT_EQ(st.st_size, full_size);
-  {
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_TRUE(p->loaded_from_cache());
-  }
-  // An unwritable cache directory is not an error.
-  {
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "/proc/steadiface").ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-  }
-  std::remove(files[0].c_str());
-  rmdir(dir.c_str());
-  rmdir(dir_template);
-}
-
-}  // namespace
-}  // namespace steadiface
-
-namespace steadiface {
-namespace {
-
-// The face detector's cached copy (in the model cache) finds the same faces
-// as dlib's shipped one; a damaged cache file is ignored and rewritten.
-TEST(FaceDetectorTest, CachedDetectorFindsTheSameFaces) {
-  char dir_template[] = "/tmp/steadiface_detcache_test_XXXXXX";
-  ASSERT_NE(mkdtemp(dir_template), nullptr);
-  const char* old = std::getenv("STEADIFACE_CACHE_DIR");
-  const std::string saved = old != nullptr ? old : "";
-  setenv("STEADIFACE_CACHE_DIR", dir_template, 1);
-  cv::Mat grey;
-  cv::cvtColor(LoadImage("astronaut.png"), grey, cv::COLOR_BGR2GRAY);
-  const cv::Rect all(0, 0, grey.cols, grey.rows);
-  auto detect = [&](std::vector<FaceBox>* faces) {
-    std::unique_ptr<FaceDetector> d;
-    ASSERT_TRUE(FaceDetector::Create(FaceDetectorOptions(), &d).ok());
-    ASSERT_TRUE(d->Detect(grey, all, faces).ok());
-  };
-  std::vector<FaceBox> fresh, cached, repaired;
-  detect(&fresh);  // decodes dlib's detector, writes the cache
-  std::vector<cv::String> files;
-  cv::glob(std::string(dir_template) + "/frontal_face_detector_*.sfcache", files, false);
-  ASSERT_EQ(files.size(), 1u);
-  std::string written;
-  ASSERT_TRUE(ReadWholeFile(files[0], &written));
-  detect(&cached);  // reads the cache
-  {
-    std::string damaged = written;
-    damaged[damaged.size() / 2] ^= 0x5a;
-    ASSERT_TRUE(WriteFileAtomically(files[0], damaged));
-  }
-  detect(&repaired);  // ignores the damaged file, rewrites it
-  std::string rewritten;
-  ASSERT_TRUE(ReadWholeFile(files[0], &rewritten));
-  EXPECT_EQ(rewritten, written);
-  ASSERT_FALSE(fresh.empty());
-  for (const auto* other : {&cached, &repaired}) {
-    ASSERT_EQ(other->size(), fresh.size());
-    for (size_t i = 0; i < fresh.size(); ++i) {
-      EXPECT_EQ((*other)[i].rect, fresh[i].rect);
-      EXPECT_EQ((*other)[i].score, fresh[i].score);
-    }
-  }
-  if (old != nullptr) {
-    setenv("STEADIFACE_CACHE_DIR", saved.c_str(), 1);
-  } else {
-    unsetenv("STEADIFACE_CACHE_DIR");
-  }
-  std::remove(files[0].c_str());
-  rmdir(dir_template);
 }
 
 }  // namespace

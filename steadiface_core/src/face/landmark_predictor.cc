@@ -119,10 +119,6 @@ class CacheReader {
 LandmarkPredictor::LandmarkPredictor() = default;
 LandmarkPredictor::~LandmarkPredictor() = default;
 
-std::string LandmarkPredictor::DefaultModelCacheDir() {
-  return steadiface::DefaultModelCacheDir();
-}
-
 Status LandmarkPredictor::Load(const std::string& path,
                                std::unique_ptr<LandmarkPredictor>* out,
                                const std::string& cache_dir) {

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "steadiface_core/model_cache.h"
 #include "steadiface_core/status.h"
 
 namespace steadiface {
@@ -35,10 +36,6 @@ class LandmarkPredictor {
   static Status Load(const std::string& path,
                      std::unique_ptr<LandmarkPredictor>* out,
                      const std::string& cache_dir = DefaultModelCacheDir());
-
-  /// $STEADIFACE_CACHE_DIR, else $XDG_CACHE_HOME/steadiface, else
-  /// $HOME/.cache/steadiface, else "" (no cache).
-  static std::string DefaultModelCacheDir();
 
   /// Whether this predictor's model came from the cache (for tests and
   /// logs).
