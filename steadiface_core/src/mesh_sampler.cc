@@ -120,10 +120,12 @@ inline void Mono8(const uchar* base, size_t step, const cv::v_int32x4& Xa,
   v_pack_u_store(out, r);
 }
 
-// 3 or 4 channels: 4 pixels of a stepped segment.
+// 3 or 4 channels: 4 pixels of a stepped segment. `wide`: 3 channels may
+// store 16 bytes (the 4 bytes past the group are the next pixels', which
+// the row's later groups or segments write afterwards).
 template <int CN>
 inline void Color4(const uchar* base, size_t step, const cv::v_int32x4& X,
-                   const cv::v_int32x4& Y, uchar* out) {
+                   const cv::v_int32x4& Y, bool wide, uchar* out) {
   using namespace cv;
   const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
   const v_int32x4 k32 = v_setall_s32(kInterTabSize);
@@ -182,6 +184,8 @@ inline void Color4(const uchar* base, size_t step, const cv::v_int32x4& X,
   const v_uint8x16 r = v_pack_u(r01, r23);
   if (CN == 4) {
     v_store(out, r);
+  } else if (wide) {
+    v_store(out, v_pack_triplets(r));
   } else {
     // 12 bytes, straight from the register (no round trip through memory).
     const v_uint8x16 packed = v_pack_triplets(r);
@@ -264,9 +268,9 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
         const cv::v_int32x4 Xv = cv::v_setall_s32(X) + ramp;
         const cv::v_int32x4 Yv = cv::v_setall_s32(Y) + rampy;
         if (cn == 3) {
-          Color4<3>(base, step, Xv, Yv, out + u * 3);
+          Color4<3>(base, step, Xv, Yv, u + 6 <= width, out + u * 3);
         } else {
-          Color4<4>(base, step, Xv, Yv, out + u * 4);
+          Color4<4>(base, step, Xv, Yv, false, out + u * 4);
         }
       }
       if (n >= 4) return;
