@@ -47,6 +47,8 @@ int Usage() {
                "       [--size WxH] [--seed N] [--render] [--crop R]\n"
                "       [--band W] [--band-inside F] [--max-offset C] [--offset-lowpass HZ]\n"
                "       [--offset-error S] [--readout-error S] (misconfigure the IMU timing)\n"
+               "       [--gyro-scale K] [--gyro-speed K] (presets with the recorded gyro\n"
+               "         trace: scale its rotation, or play it K times as fast)\n"
                "         (the layered warp's warp/layered/* options, for sweeps)\n";
   return 2;
 }
@@ -66,6 +68,8 @@ int main(int argc, char** argv) {
   // Deliberate misconfiguration of the camera-IMU timing [s] (calibration
   // studies): added to imu/time_offset and camera/readout_time.
   double offset_error = 0.0, readout_error = 0.0;
+  // The recorded trace's scale and playback speed (NaN: the preset's).
+  double gyro_scale = NAN, gyro_speed = NAN;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -83,6 +87,8 @@ int main(int argc, char** argv) {
     else if (a == "--crop") crop = std::atof(next().c_str());
     else if (a == "--offset-error") offset_error = std::atof(next().c_str());
     else if (a == "--readout-error") readout_error = std::atof(next().c_str());
+    else if (a == "--gyro-scale") gyro_scale = std::atof(next().c_str());
+    else if (a == "--gyro-speed") gyro_speed = std::atof(next().c_str());
     else if (a == "--band") blend.band_width = std::atof(next().c_str());
     else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
     else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
@@ -152,6 +158,8 @@ int main(int argc, char** argv) {
     so.height = height;
     so.seed = seed;
     steadiface::Status s = steadiface::sim::ApplyPreset(preset, &so);
+    if (std::isfinite(gyro_scale)) so.real_gyro_scale = gyro_scale;
+    if (std::isfinite(gyro_speed)) so.real_gyro_speed = gyro_speed;
     std::unique_ptr<steadiface::sim::Simulator> sim;
     if (s.ok()) s = steadiface::sim::Simulator::Create(so, &sim);
     if (s.ok() && !std::isfinite(duration) && sim->real_gyro_span_s() > so.duration_s) {

@@ -148,6 +148,10 @@ Status Simulator::Create(const SimulatorOptions& options, std::unique_ptr<Simula
       o.exposure_samples > 64) {
     return Status::Error("sim: exposure must be in [0, 1/fps] s with 1-64 samples");
   }
+  if (!(o.real_gyro_scale > 0.0 && o.real_gyro_scale <= 10.0) ||
+      !(o.real_gyro_speed > 0.0 && o.real_gyro_speed <= 10.0)) {
+    return Status::Error("sim: real_gyro_scale and real_gyro_speed must be in (0, 10]");
+  }
   std::unique_ptr<Simulator> s(new Simulator(options));
   Status st = s->Init();
   if (!st.ok()) return st;
@@ -270,7 +274,7 @@ Status Simulator::Init() {
     if (real_gyro_) {
       double sign = 1.0;
       real_gyro_->AngularVelocity(Time(FromSeconds(RealGyroTime(t, &sign))), &w);
-      w *= sign;
+      w *= sign * o.real_gyro_speed;
     } else {
       w = camera_.AngularVelocity(t);
     }
@@ -293,7 +297,7 @@ double Simulator::RealGyroTime(double t, double* sign) const {
   // Longer sequences play the trace forwards, then backwards (a smooth,
   // continuous orientation path; angular velocity flips sign).
   const double T = real_gyro_span_s_;
-  double u = std::fmod(std::max(0.0, t), 2.0 * T);
+  double u = std::fmod(std::max(0.0, t * options_.real_gyro_speed), 2.0 * T);
   *sign = 1.0;
   if (u > T) {
     u = 2.0 * T - u;

@@ -59,6 +59,11 @@ struct SimulatorOptions {
   /// so the face stays in view while the background pans.
   bool pan_orbits_head = true;
   double real_gyro_scale = 1.0;
+  /// Playback speed of the real trace [-]: 2 plays it twice as fast, which
+  /// doubles the angular velocity (blur, rolling-shutter skew) and the
+  /// frequencies but keeps the rotation's amplitude (what the crop must
+  /// absorb); real_gyro_scale scales both velocity and amplitude.
+  double real_gyro_speed = 1.0;
   /// Head motion relative to the body, and the body's walking motion shared
   /// by camera and head [m, Hz].
   HeadMotionOptions head;
