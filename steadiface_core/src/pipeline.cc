@@ -194,6 +194,9 @@ void Pipeline::RenderDeferred(const cv::Mat& image, PipelineFrame* frame) {
              &frame->output);
   frame->timings.maps_ms = 0.0;
   frame->timings.remap_ms = MsSince(t0);
+  // The frame's work: processing plus this render (which ran beside the
+  // next frame's processing, so this is not the frame's latency).
+  frame->timings.total_ms += frame->timings.remap_ms;
 }
 
 void Pipeline::ApplyOffsetEstimate(Time stamp) {

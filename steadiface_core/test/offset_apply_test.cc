@@ -149,6 +149,7 @@ TEST(DeferredRenderTest, MatchesTheOneStagePipelineBitForBit) {
     size_t g1 = 0, g2 = 0;
     std::thread worker;
     PipelineFrame held;
+    double held_processing_ms = 0.0;
     cv::Mat held_image;
     std::vector<cv::Mat> expected, got;
     for (int i = 0; i < sim->num_frames(); ++i) {
@@ -167,12 +168,18 @@ TEST(DeferredRenderTest, MatchesTheOneStagePipelineBitForBit) {
         worker.join();
         got.push_back(held.output);
       }
+      // total_ms counts the render too once it has run (the published
+      // StabilizerState's processing time).
+      EXPECT_EQ(b.timings.remap_ms, 0.0);
+      held_processing_ms = b.timings.total_ms;
       held = std::move(b);
       held_image = frame;
       worker = std::thread([&held, &held_image] { Pipeline::RenderDeferred(held_image, &held); });
     }
     worker.join();
     got.push_back(held.output);
+    EXPECT_GT(held.timings.remap_ms, 0.0);
+    EXPECT_EQ(held.timings.total_ms, held_processing_ms + held.timings.remap_ms);
     ASSERT_EQ(got.size(), expected.size());
     for (size_t i = 0; i < got.size(); ++i) {
       ASSERT_EQ(got[i].size(), expected[i].size());

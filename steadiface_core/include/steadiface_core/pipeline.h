@@ -126,7 +126,8 @@ class Pipeline {
                               const std::vector<Eigen::Vector2d>* external_landmarks,
                               double external_confidence, PipelineFrame* out);
   /// Renders a deferred frame's output from its own mesh (touches no
-  /// pipeline state: thread-safe). Sets timings.remap_ms.
+  /// pipeline state: thread-safe). Sets timings.remap_ms and adds it to
+  /// timings.total_ms (the frame's work, processing and render).
   static void RenderDeferred(const cv::Mat& image, PipelineFrame* frame);
 
   /// Without gyro: the plain centre crop (identity pose), same output size
