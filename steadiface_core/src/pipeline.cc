@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include <opencv2/imgproc.hpp>
+
 #include "steadiface_core/mesh_sampler.h"
 
 namespace steadiface {
@@ -97,6 +99,14 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   const auto t_face = std::chrono::steady_clock::now();
   const FaceObservation* obs = nullptr;
   FaceObservation observation;
+  // The tracker and the check both work on grey: convert once (the same
+  // cv::cvtColor each would run, so their results do not change).
+  cv::Mat grey = image;
+  const bool internal_face =
+      tracker_ != nullptr && options_.landmark_source != LandmarkSource::kExternal;
+  if (internal_face && image.channels() > 1) {
+    cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  }
   if (tracker_ != nullptr) {
     Status s;
     if (options_.landmark_source == LandmarkSource::kExternal) {
@@ -105,7 +115,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
                                     external_confidence, stamp, &timeline_, &timing_,
                                     &f.face);
     } else {
-      s = tracker_->Process(image, stamp, &timeline_, &timing_, &f.face);
+      s = tracker_->Process(grey, stamp, &timeline_, &timing_, &f.face);
     }
     // A face error never stops stabilization: it is a frame without a face.
     if (f.face.valid) {
@@ -117,7 +127,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   // The gyro-vs-video check (never changes the pose), outside the face.
   if (check_ != nullptr) {
     const auto t_check = std::chrono::steady_clock::now();
-    check_->Process(image, stamp, timeline_, f.face.valid ? f.face.box : cv::Rect2d());
+    check_->Process(grey, stamp, timeline_, f.face.valid ? f.face.box : cv::Rect2d());
     f.gyro_video_check = check_->result();
     f.timings.check_ms = MsSince(t_check);
   }
