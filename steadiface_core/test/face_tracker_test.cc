@@ -281,15 +281,35 @@ TEST(FaceTrackerTest, NoFaceGivesSearching) {
   cv::Mat bg;
   cv::resize(LoadImage("building.jpg"), bg, cv::Size(640, 360));
   const CameraModel m = ModelFor(640, 360);
+  // The default search interval (0.1 s) at 30 fps: the full-frame search
+  // runs on frames 0, 3, 6, ...; the frames between say not_searched.
   auto t = Tracker(m);
-  for (int i = 0; i < 3; ++i) {
+  ASSERT_DOUBLE_EQ(FaceTrackerOptions().search_interval_s, 0.1);
+  for (int i = 0; i < 8; ++i) {
     FaceInfo fi;
-    ASSERT_TRUE(t->Process(bg, At(1.0 + i * 0.03), nullptr, nullptr, &fi).ok());
+    ASSERT_TRUE(t->Process(bg, At(1.0 + i / 30.0), nullptr, nullptr, &fi).ok());
     EXPECT_EQ(fi.state, TrackingState::kSearching);
     EXPECT_FALSE(fi.valid);
-    EXPECT_EQ(fi.failure, FaceFailure::kNoFace);
     EXPECT_TRUE(fi.landmarks_px.empty());
+    const bool searched = i % 3 == 0;
+    EXPECT_EQ(fi.detected, searched) << i;
+    EXPECT_EQ(fi.failure, searched ? FaceFailure::kNoFace : FaceFailure::kNotSearched) << i;
+    EXPECT_EQ(fi.timings.detect_ms > 0.0, searched) << i;
   }
+  // search_interval 0: every frame searches.
+  FaceTrackerOptions every;
+  every.search_interval_s = 0.0;
+  auto u = Tracker(m, every);
+  for (int i = 0; i < 3; ++i) {
+    FaceInfo fi;
+    ASSERT_TRUE(u->Process(bg, At(1.0 + i / 30.0), nullptr, nullptr, &fi).ok());
+    EXPECT_TRUE(fi.detected);
+    EXPECT_EQ(fi.failure, FaceFailure::kNoFace);
+  }
+  FaceTrackerOptions bad;
+  bad.search_interval_s = -1.0;
+  std::unique_ptr<FaceTracker> none;
+  EXPECT_FALSE(FaceTracker::Create(m, bad, &none).ok());
 }
 
 // Two copies of the portrait's head pasted on a background at given scales.

@@ -49,6 +49,8 @@ int Usage() {
                "       [--offset-error S] [--readout-error S] (misconfigure the IMU timing)\n"
                "       [--gyro-scale K] [--gyro-speed K] (presets with the recorded gyro\n"
                "         trace: scale its rotation, or play it K times as fast)\n"
+               "       [--search-interval S] (face.search_interval: full-frame face search\n"
+               "         at most once per S while no face is locked; 0 = every frame)\n"
                "         (the layered warp's warp/layered/* options, for sweeps)\n";
   return 2;
 }
@@ -70,6 +72,7 @@ int main(int argc, char** argv) {
   double offset_error = 0.0, readout_error = 0.0;
   // The recorded trace's scale and playback speed (NaN: the preset's).
   double gyro_scale = NAN, gyro_speed = NAN;
+  double search_interval = NAN;  // face.search_interval [s]; NaN: the default
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -89,6 +92,7 @@ int main(int argc, char** argv) {
     else if (a == "--readout-error") readout_error = std::atof(next().c_str());
     else if (a == "--gyro-scale") gyro_scale = std::atof(next().c_str());
     else if (a == "--gyro-speed") gyro_speed = std::atof(next().c_str());
+    else if (a == "--search-interval") search_interval = std::atof(next().c_str());
     else if (a == "--band") blend.band_width = std::atof(next().c_str());
     else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
     else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
@@ -237,6 +241,7 @@ int main(int argc, char** argv) {
                                                         : Method::kSteadiface;
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
+        if (std::isfinite(search_interval)) po.face.search_interval_s = search_interval;
         po.warp.layered.blend = blend;
         po.imu.imu_time_offset_s += offset_error;
         po.shutter.readout_time_s = std::max(0.0, po.shutter.readout_time_s + readout_error);

@@ -242,6 +242,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Num("face/redetect_region_scale", &f.redetect_region_scale, 1.0, 10.0);
   r.Int("face/redetect_face_px", &f.redetect_face_px, 60, 1000);
   r.Num("face/lost_timeout", &f.lost_timeout_s, 0.0, 60.0);
+  r.Num("face/search_interval", &f.search_interval_s, 0.0, 10.0);
   r.Num("face/max_shape_residual", &f.max_shape_residual, 0.001, 2.0);
   r.Num("face/min_spread_ratio", &f.min_spread_ratio, 0.01, 10.0);
   r.Num("face/max_spread_ratio", &f.max_spread_ratio, 0.01, 10.0);

@@ -89,6 +89,8 @@ Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
     err << "face.redetect_face_px must be in [60, 1000], got " << o.redetect_face_px;
   } else if (!(o.lost_timeout_s >= 0.0 && o.lost_timeout_s <= 60.0)) {
     err << "face.lost_timeout must be in [0, 60] s, got " << o.lost_timeout_s;
+  } else if (!(o.search_interval_s >= 0.0 && o.search_interval_s <= 10.0)) {
+    err << "face.search_interval must be in [0, 10] s, got " << o.search_interval_s;
   } else if (!(o.max_shape_residual > 0.0 && o.max_shape_residual <= 2.0)) {
     err << "face.max_shape_residual must be in (0, 2], got " << o.max_shape_residual;
   } else if (!(o.min_spread_ratio > 0.0 && o.min_spread_ratio < o.max_spread_ratio &&
@@ -137,6 +139,7 @@ void FaceTracker::reset() {
   frames_since_detect_ = 0;
   frames_tracked_ = 0;
   force_detect_ = true;
+  have_last_search_ = false;
 }
 
 Eigen::Quaterniond FaceTracker::MidRotation(Time stamp,
@@ -439,7 +442,17 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
   Candidate c;
   cv::Mat patch;
   bool ok = false;
-  if (state_ == TrackingState::kSearching) {
+  // While searching, the full-frame detection runs once per
+  // search_interval_s (1 ms of slack for frame-time jitter); a time jump
+  // backwards searches at once.
+  const bool search_due =
+      !have_last_search_ || stamp < last_search_ ||
+      ToSeconds(stamp - last_search_) >= options_.search_interval_s - 1e-3;
+  if (state_ == TrackingState::kSearching && !search_due) {
+    MarkFailure(FaceFailure::kNotSearched, stamp, info);
+  } else if (state_ == TrackingState::kSearching) {
+    have_last_search_ = true;
+    last_search_ = stamp;
     const auto t0 = Clock::now();
     std::vector<FaceBox> faces;
     detector_->Detect(gray, full, &faces);

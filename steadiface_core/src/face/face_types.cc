@@ -32,6 +32,8 @@ const char* FaceFailureName(FaceFailure f) {
       return "out_of_frame";
     case FaceFailure::kBadInput:
       return "bad_input";
+    case FaceFailure::kNotSearched:
+      return "not_searched";
   }
   return "unknown";
 }

@@ -34,6 +34,8 @@ enum class FaceFailure {
   kAppearance,        ///< face patch no longer looks like the locked face
   kOutOfFrame,        ///< the predicted box left the image
   kBadInput,          ///< empty / tiny / non-8-bit image, or bad landmarks
+  kNotSearched,       ///< searching, but no full-frame detection this frame
+                      ///< (face.search_interval)
 };
 
 const char* TrackingStateName(TrackingState s);
