@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include <ceres/autodiff_cost_function.h>
 #include <ceres/manifold.h>
 #include <gtest/gtest.h>
 
@@ -20,6 +21,7 @@
 #include "steadiface_core/stabilizer/head_smoother.h"
 #include "steadiface_core/stabilizer/protrusion_cost.h"
 #include "steadiface_core/stabilizer/rotation_smoothness_cost.h"
+#include "steadiface_core/stabilizer/stall_tolerant_solve.h"
 #include "steadiface_core/stabilizer/translation_smoothness_cost.h"
 #include "test_util.h"
 
@@ -279,6 +281,60 @@ TEST(HeadSmootherTest, StaysForSmallNoiseFollowsLargeMoves) {
     EXPECT_LT(std::abs(H.x() - 0.7), r.x());
   }
   EXPECT_NEAR(H.x(), 0.7, 0.005);
+}
+
+// Rosenbrock's valley: several steps from (-1.2, 1) to (1, 1).
+struct Rosenbrock {
+  template <typename T>
+  bool operator()(const T* x, T* r) const {
+    r[0] = T(1.0) - x[0];
+    r[1] = T(10.0) * (x[1] - x[0] * x[0]);
+    return true;
+  }
+};
+
+// The solver's wall-time cap runs out before the first step (a stall): plain
+// Ceres returns the starting point; StallTolerantSolve puts the parameters
+// back and reruns, giving exactly the uncapped solve.
+TEST(StallTolerantSolveTest, ACapThatRunsOutBeforeTheFirstStepIsRerun) {
+  auto solve = [](double cap, bool tolerant, bool* rerun, ceres::Solver::Summary* summary) {
+    double x[2] = {-1.2, 1.0};
+    ceres::Problem problem;
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<Rosenbrock, 2, 2>(new Rosenbrock), nullptr, x);
+    ceres::Solver::Options o;
+    o.linear_solver_type = ceres::DENSE_QR;
+    o.max_num_iterations = 50;
+    o.max_solver_time_in_seconds = cap;
+    o.logging_type = ceres::SILENT;
+    *rerun = false;
+    if (tolerant) {
+      *rerun = StallTolerantSolve(
+          o, &problem, [&x] { x[0] = -1.2, x[1] = 1.0; }, summary);
+    } else {
+      ceres::Solve(o, &problem, summary);
+    }
+    return Eigen::Vector2d(x[0], x[1]);
+  };
+  bool rerun = false;
+  ceres::Solver::Summary s_free, s_stalled, s_tolerant, s_tolerant_free;
+  const Eigen::Vector2d free = solve(1e6, false, &rerun, &s_free);
+  EXPECT_EQ(s_free.termination_type, ceres::CONVERGENCE);
+  EXPECT_NEAR(free.x(), 1.0, 1e-6);
+  EXPECT_NEAR(free.y(), 1.0, 1e-6);
+  // The stall, as plain Ceres sees it: no step, the starting point back.
+  const Eigen::Vector2d stalled = solve(1e-12, false, &rerun, &s_stalled);
+  EXPECT_EQ(s_stalled.termination_type, ceres::NO_CONVERGENCE);
+  EXPECT_EQ(stalled, Eigen::Vector2d(-1.2, 1.0));
+  // Tolerant: rerun, and bit for bit the uncapped answer.
+  const Eigen::Vector2d tolerant = solve(1e-12, true, &rerun, &s_tolerant);
+  EXPECT_TRUE(rerun);
+  EXPECT_EQ(s_tolerant.termination_type, ceres::CONVERGENCE);
+  EXPECT_EQ(tolerant, free);
+  // A cap that does not run out changes nothing.
+  const Eigen::Vector2d untouched = solve(1e6, true, &rerun, &s_tolerant_free);
+  EXPECT_FALSE(rerun);
+  EXPECT_EQ(untouched, free);
 }
 
 }  // namespace

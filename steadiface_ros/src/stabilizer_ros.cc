@@ -314,6 +314,7 @@ void StabilizerRos::DiagSolver(diagnostic_updater::DiagnosticStatusWrapper& s) {
   s.add("last iterations", w.last_solver_iterations);
   s.add("last time [ms]", w.last_solver_ms);
   s.add("failures (previous solution kept)", w.stabilizer.solver_failures);
+  s.add("reruns (time cap ran out before the first step)", w.stabilizer.solver_restarts);
   s.add("frames", w.stabilizer.frames);
   if (w.stabilizer.solver_failures > reported_solver_failures_) {
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "solver failed; previous solution kept");

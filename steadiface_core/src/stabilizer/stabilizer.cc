@@ -15,6 +15,7 @@
 #include "steadiface_core/stabilizer/following_cost.h"
 #include "steadiface_core/stabilizer/protrusion_cost.h"
 #include "steadiface_core/stabilizer/rotation_smoothness_cost.h"
+#include "steadiface_core/stabilizer/stall_tolerant_solve.h"
 #include "steadiface_core/stabilizer/translation_smoothness_cost.h"
 
 namespace steadiface {
@@ -407,7 +408,18 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
+  // A time cap that runs out before the first step (a stall) would leave the
+  // initial pose, the previous warp with this frame's shake in it: the
+  // solve is then rerun under the iteration cap alone (10 cheap steps).
+  if (StallTolerantSolve(so, &problem,
+                         [&] {
+                           pp->q() = R_v0.coeffs();
+                           pp->t() = t0;
+                         },
+                         &summary)) {
+    f->solver.restarted = true;
+    ++stats->solver_restarts;
+  }
   f->solver.ran = true;
   f->solver.iterations = static_cast<int>(summary.iterations.size()) - 1;
   f->solver.termination = ceres::TerminationTypeToString(summary.termination_type);

@@ -266,6 +266,7 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       << ws.stabilizer.previous_warp_fallbacks
       << ",\n  \"undefined_frames\": " << ws.stabilizer.undefined_frames
       << ",\n  \"solver_failures\": " << ws.stabilizer.solver_failures
+      << ",\n  \"solver_restarts\": " << ws.stabilizer.solver_restarts
       << ",\n  \"frames_with_face\": " << ws.stabilizer.frames_with_face
       << ",\n  \"face_lost_frames_by_reason\": {";
   bool first_reason = true;

@@ -44,6 +44,9 @@ struct SolverReport {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   double time_ms = 0.0;
+  /// The wall-time cap ran out before the first step (a stall) and the
+  /// solve was run again under the iteration cap alone.
+  bool restarted = false;
 };
 
 /// Why the pose is what it is.
@@ -105,6 +108,8 @@ struct StabilizerStats {
   uint64_t frames = 0;
   uint64_t frames_with_face = 0;
   uint64_t solver_failures = 0;
+  /// Solves whose time cap ran out before their first step and were rerun.
+  uint64_t solver_restarts = 0;
   uint64_t protrusion_searches = 0;
   uint64_t previous_warp_fallbacks = 0;
   uint64_t undefined_frames = 0;
@@ -121,7 +126,8 @@ struct StabilizerStats {
 /// nothing valid exists.
 ///
 /// Deterministic (single-threaded Ceres, no wall-clock dependence unless
-/// solver.max_time_s is hit). Not thread-safe: one instance per stream.
+/// solver.max_time_s runs out after the solve's first step; a cap that
+/// runs out before it, a stall, reruns the solve under the iteration cap). Not thread-safe: one instance per stream.
 class Stabilizer {
  public:
   static Status Create(const CameraModel& model, const OutputOptions& output,
