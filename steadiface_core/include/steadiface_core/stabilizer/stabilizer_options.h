@@ -95,7 +95,9 @@ struct SolverOptions {
   double function_tolerance = 1e-6;
   /// Gradient tolerance [-].
   double gradient_tolerance = 1e-10;
-  /// Wall-time cap per solve [s].
+  /// Wall-time cap per solve [s]. A cap that runs out before the solver's
+  /// first step is taken as a stall and the solve is rerun under
+  /// max_iterations alone (StallTolerantSolve).
   double max_time_s = 0.02;
 };
 
