@@ -127,7 +127,8 @@ struct StabilizerStats {
 ///
 /// Deterministic (single-threaded Ceres, no wall-clock dependence unless
 /// solver.max_time_s runs out after the solve's first step; a cap that
-/// runs out before it, a stall, reruns the solve under the iteration cap). Not thread-safe: one instance per stream.
+/// runs out before it, a stall, reruns the solve under the iteration cap).
+/// Not thread-safe: one instance per stream.
 class Stabilizer {
  public:
   static Status Create(const CameraModel& model, const OutputOptions& output,
