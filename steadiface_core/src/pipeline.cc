@@ -3,8 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
-#include <opencv2/imgproc.hpp>
-
+#include "steadiface_core/grey.h"
 #include "steadiface_core/mesh_sampler.h"
 
 namespace steadiface {
@@ -101,12 +100,9 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   FaceObservation observation;
   // The tracker and the check both work on grey: convert once (the same
   // cv::cvtColor each would run, so their results do not change).
-  cv::Mat grey = image;
   const bool internal_face =
       tracker_ != nullptr && options_.landmark_source != LandmarkSource::kExternal;
-  if (internal_face && image.channels() > 1) {
-    cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
-  }
+  const cv::Mat grey = internal_face ? ToGrey(image) : image;
   if (tracker_ != nullptr) {
     Status s;
     if (options_.landmark_source == LandmarkSource::kExternal) {

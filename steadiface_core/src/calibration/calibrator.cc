@@ -13,6 +13,7 @@
 
 #include "steadiface_core/calibration/gyro_integral.h"
 #include "steadiface_core/calibration/gyro_video_check.h"
+#include "steadiface_core/grey.h"
 #include "steadiface_core/lens_distortion.h"
 #include "steadiface_core/percentile.h"
 #include "steadiface_core/so3.h"
@@ -170,14 +171,7 @@ Status Calibrator::AddFrame(const cv::Mat& image, Time stamp) {
   if (frames_ > 0 && stamp <= prev_stamp_) {
     return Status::Error("calibrate: frame stamps must increase");
   }
-  cv::Mat grey;
-  if (image.channels() == 1) {
-    grey = image;
-  } else {
-    cv::cvtColor(
-        image, grey,
-        image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
-  }
+  cv::Mat grey = ToGrey(image);
   if (scale_ < 1.0)
     cv::resize(grey, grey, cv::Size(), scale_, scale_, cv::INTER_AREA);
   if (frames_ == 0) first_stamp_ = stamp;

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "steadiface_core/grey.h"
 #include "steadiface_core/lens_distortion.h"
 
 namespace steadiface {
@@ -145,14 +146,7 @@ void GyroVideoCheck::Process(const cv::Mat& image, Time stamp,
     EvaluateReady(timeline);
     return;
   }
-  cv::Mat grey;
-  if (image.channels() == 1) {
-    grey = image;
-  } else {
-    cv::cvtColor(
-        image, grey,
-        image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
-  }
+  cv::Mat grey = ToGrey(image);
   if (scale_ < 1.0) {
     cv::resize(grey, grey, cv::Size(), scale_, scale_, cv::INTER_LINEAR);
   } else {

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "steadiface_core/face/head_pose.h"
+#include "steadiface_core/grey.h"
 #include "steadiface_core/lens_distortion.h"
 
 namespace steadiface {
@@ -425,12 +426,7 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
         << image.type();
     return Status::Error(err.str());
   }
-  cv::Mat gray;
-  if (image.channels() == 1) {
-    gray = image;
-  } else {
-    cv::cvtColor(image, gray, image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
-  }
+  const cv::Mat gray = ToGrey(image);
   bool rot_ok = false;
   const Eigen::Quaterniond R_now = MidRotation(stamp, timeline, timing, &rot_ok);
   const cv::Rect full(0, 0, gray.cols, gray.rows);
