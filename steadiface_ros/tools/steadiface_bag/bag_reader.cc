@@ -3,6 +3,9 @@
 #include <iostream>
 #include <map>
 
+#include <type_traits>
+
+#include <ros/serialization.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CompressedImage.h>
 
@@ -64,6 +67,15 @@ steadiface::Status BagReader::Open(bool info_required) {
       has_info_ = true;
     }
   }
+  if (use_indexed_reader_) {
+    fast_.reset(new IndexedBagReader(verify_checksums_));
+    std::string why;
+    if (!fast_->Open(path_, &why)) {
+      std::cerr << "steadiface_bag: reading " << path_ << " through rosbag::View (" << why
+                << ")\n";
+      fast_.reset();
+    }
+  }
   return Status::Ok();
 }
 
@@ -92,36 +104,77 @@ void BagReader::Start(BoundedQueue<BagItem>* queue) {
                       info = NormalizeTopic(topics_.info),
                       landmarks = NormalizeTopic(topics_.landmarks),
                       image = NormalizeTopic(topics_.image);
-    try {
-      rosbag::View view(bag_, rosbag::TopicQuery(topics));
-      for (const rosbag::MessageInstance& m : view) {
-        BagItem item;
-        const std::string topic = NormalizeTopic(m.getTopic());
-        item.time = m.getTime();
-        if (topic == imu) {
-          item.imu = m.instantiate<sensor_msgs::Imu>();
-        } else if (topic == info) {
-          item.info = m.instantiate<sensor_msgs::CameraInfo>();
-        } else if (topic == landmarks) {
-          item.landmarks = m.instantiate<steadiface::FaceLandmarks>();
-        } else if (topic == image && !compressed_) {
-          item.image = m.instantiate<sensor_msgs::Image>();
-        } else if (topic == image) {
-          sensor_msgs::CompressedImageConstPtr c =
-              m.instantiate<sensor_msgs::CompressedImage>();
-          sensor_msgs::ImagePtr decoded;
-          const steadiface::Status s =
-              c ? steadiface_ros::FromCompressedImage(*c, &decoded)
-                : steadiface::Status::Error(
-                      "not a sensor_msgs/CompressedImage");
-          if (s.ok()) {
-            item.image = decoded;
-          } else if (decode_failures_++ == 0) {
-            std::cerr << "steadiface_bag: " << s.message()
-                      << " (frame skipped)\n";
-          }
+    // One message of `raw_topic` at `time`; `as(static_cast<M*>(nullptr))`
+    // gives it as an M (null if it is not one). False when the queue is
+    // closed.
+    auto dispatch = [&](const std::string& raw_topic, const ros::Time& time,
+                        auto as) -> bool {
+      BagItem item;
+      const std::string topic = NormalizeTopic(raw_topic);
+      item.time = time;
+      if (topic == imu) {
+        item.imu = as(static_cast<sensor_msgs::Imu*>(nullptr));
+      } else if (topic == info) {
+        item.info = as(static_cast<sensor_msgs::CameraInfo*>(nullptr));
+      } else if (topic == landmarks) {
+        item.landmarks = as(static_cast<steadiface::FaceLandmarks*>(nullptr));
+      } else if (topic == image && !compressed_) {
+        item.image = as(static_cast<sensor_msgs::Image*>(nullptr));
+      } else if (topic == image) {
+        sensor_msgs::CompressedImageConstPtr c =
+            as(static_cast<sensor_msgs::CompressedImage*>(nullptr));
+        sensor_msgs::ImagePtr decoded;
+        const steadiface::Status s =
+            c ? steadiface_ros::FromCompressedImage(*c, &decoded)
+              : steadiface::Status::Error("not a sensor_msgs/CompressedImage");
+        if (s.ok()) {
+          item.image = decoded;
+        } else if (decode_failures_++ == 0) {
+          std::cerr << "steadiface_bag: " << s.message() << " (frame skipped)\n";
         }
-        if (!queue->Push(std::move(item))) break;
+      }
+      return queue->Push(std::move(item));
+    };
+    try {
+      if (fast_) {
+        fast_->Select(topics);
+        IndexedBagReader::Message m;
+        std::string err;
+        while (fast_->Next(&m, &err)) {
+          const std::string& topic = fast_->connections().at(m.connection).topic;
+          const std::string& datatype = fast_->connections().at(m.connection).datatype;
+          auto as = [this, &m, &topic, &datatype](auto* type) {
+            using M = std::remove_pointer_t<decltype(type)>;
+            // As MessageInstance::instantiate: null for another type.
+            if (datatype != ros::message_traits::datatype<M>()) {
+              return boost::shared_ptr<const M>();
+            }
+            boost::shared_ptr<M> msg(new M);
+            try {
+              ros::serialization::IStream s(const_cast<uint8_t*>(m.data), m.size);
+              ros::serialization::deserialize(s, *msg);
+            } catch (const ros::Exception& e) {
+              // A damaged message (rosbag::View would stop the whole read).
+              if (decode_failures_++ == 0) {
+                std::cerr << "steadiface_bag: a message on " << topic
+                          << " does not deserialize (" << e.what() << "; skipped)\n";
+              }
+              msg.reset();
+            }
+            return boost::shared_ptr<const M>(msg);
+          };
+          if (!dispatch(topic, m.time, as)) break;
+        }
+        if (!err.empty()) error_ = err;
+      } else {
+        rosbag::View view(bag_, rosbag::TopicQuery(topics));
+        for (const rosbag::MessageInstance& m : view) {
+          auto as = [&m](auto* type) {
+            using M = std::remove_pointer_t<decltype(type)>;
+            return boost::shared_ptr<const M>(m.instantiate<M>());
+          };
+          if (!dispatch(m.getTopic(), m.getTime(), as)) break;
+        }
       }
     } catch (const std::exception& e) {
       error_ = e.what();

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -11,6 +12,7 @@
 
 #include "steadiface/FaceLandmarks.h"
 #include "steadiface_bag/bounded_queue.h"
+#include "steadiface_bag/indexed_bag_reader.h"
 #include "steadiface_core/status.h"
 
 namespace steadiface_bag {
@@ -41,11 +43,22 @@ struct BagItem {
 /// The reader stage: opens the input bag, checks its topics and types, and
 /// decodes the wanted messages in bag order on its own thread into a bounded
 /// queue (LZ4/BZ2 decompression and deserialization overlap the
-/// stabilizer).
+/// stabilizer). The messages come through IndexedBagReader when the bag is
+/// one it reads (version 2.0, indexed, chunks uncompressed or LZ4: what
+/// `rosbag record` writes), else through rosbag::View; the order is the
+/// same either way.
 class BagReader {
  public:
-  BagReader(const std::string& path, const BagTopics& topics)
-      : path_(path), topics_(topics) {}
+  /// `use_indexed_reader`: read through IndexedBagReader when the bag is
+  /// one it handles (the same messages in the same order, less work),
+  /// else through rosbag::View. `verify_checksums`: the indexed reader
+  /// checks LZ4 checksums (rosbag::View always does).
+  BagReader(const std::string& path, const BagTopics& topics, bool use_indexed_reader = true,
+            bool verify_checksums = false)
+      : path_(path),
+        topics_(topics),
+        use_indexed_reader_(use_indexed_reader),
+        verify_checksums_(verify_checksums) {}
   ~BagReader();
 
   /// Opens the bag and checks the topics. A missing image topic, a wrong
@@ -58,7 +71,8 @@ class BagReader {
   /// The image topic holds sensor_msgs/CompressedImage (jpeg/png, decoded
   /// on the reader thread).
   bool compressed() const { return compressed_; }
-  /// Compressed images that did not decode (read after Join).
+  /// Compressed images that did not decode, and (indexed reader) messages
+  /// that did not deserialize; each skipped (read after Join).
   size_t decode_failures() const { return decode_failures_; }
   /// Number of messages on the image topic.
   size_t ImageCount() const;
@@ -66,14 +80,22 @@ class BagReader {
   void Start(BoundedQueue<BagItem>* queue);
   /// Waits for the reader thread; returns its error ("" if none).
   std::string Join();
-  void Close() { bag_.close(); }
+  void Close() {
+    fast_.reset();
+    bag_.close();
+  }
+  /// Whether the messages are read through IndexedBagReader (after Open).
+  bool indexed() const { return fast_ != nullptr; }
 
  private:
   std::vector<std::string> WithAndWithoutSlash(const std::string& t) const;
 
   const std::string path_;
   const BagTopics topics_;
+  const bool use_indexed_reader_;
+  const bool verify_checksums_;
   rosbag::Bag bag_;
+  std::unique_ptr<IndexedBagReader> fast_;
   bool has_info_ = false;
   bool compressed_ = false;
   size_t decode_failures_ = 0;  // written by the reader thread, read after join

@@ -1,0 +1,302 @@
+// IndexedBagReader against rosbag::View: the same messages, bytes and times
+// in the same order, on bags written by rosbag::Bag itself (chunks
+// uncompressed and LZ4, many chunks, times out of order, ties between
+// connections, two connections on one topic); the bags it must refuse;
+// corrupt files.
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <ros/serialization.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
+
+#include "steadiface_bag/indexed_bag_reader.h"
+
+namespace steadiface_bag {
+namespace {
+
+struct Seen {
+  std::string topic;
+  ros::Time time;
+  std::vector<uint8_t> bytes;
+  bool operator==(const Seen& o) const {
+    return topic == o.topic && time == o.time && bytes == o.bytes;
+  }
+};
+
+class TempDir {
+ public:
+  TempDir() {
+    char tmpl[] = "/tmp/steadiface_bag_reader_testXXXXXX";
+    const char* d = mkdtemp(tmpl);
+    path_ = d != nullptr ? d : "/tmp";
+  }
+  ~TempDir() { std::system(("rm -rf '" + path_ + "'").c_str()); }
+  std::string File(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+std::vector<Seen> ReadWithView(const std::string& path,
+                               const std::vector<std::string>& topics) {
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  std::vector<Seen> out;
+  for (const rosbag::MessageInstance& m :
+       rosbag::View(bag, rosbag::TopicQuery(topics))) {
+    Seen s;
+    s.topic = m.getTopic();
+    s.time = m.getTime();
+    s.bytes.resize(m.size());
+    ros::serialization::OStream os(s.bytes.data(), s.bytes.size());
+    m.write(os);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+std::vector<Seen> ReadIndexed(const std::string& path,
+                              const std::vector<std::string>& topics,
+                              bool verify_checksums, std::string* error) {
+  IndexedBagReader reader(verify_checksums);
+  std::string why;
+  EXPECT_TRUE(reader.Open(path, &why)) << why;
+  reader.Select(topics);
+  std::vector<Seen> out;
+  IndexedBagReader::Message m;
+  while (reader.Next(&m, error)) {
+    Seen s;
+    s.topic = reader.connections().at(m.connection).topic;
+    s.time = m.time;
+    s.bytes.assign(m.data, m.data + m.size);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+// Image i: small and regular, or (`noise`) 64 x 64 of pseudo-random
+// pixels, so that chunk data outweighs the index.
+sensor_msgs::Image MakeImage(int i, bool noise = false) {
+  sensor_msgs::Image im;
+  im.header.seq = i;
+  im.header.frame_id = "camera";
+  im.width = noise ? 64 : 16 + i % 5;
+  im.height = noise ? 64 : 8;
+  im.encoding = "mono8";
+  im.step = im.width;
+  im.data.resize(im.width * im.height);
+  std::mt19937 rng(i);
+  for (size_t k = 0; k < im.data.size(); ++k) {
+    im.data[k] = static_cast<uint8_t>(noise ? rng() : k * 7 + i);
+  }
+  return im;
+}
+
+// A bag with the traits that decide View's order: images and camera_info
+// at the same stamps, IMU on a grid that meets the image stamps every third
+// frame, a second IMU connection (another publisher) on the same topic, a
+// few messages written out of time order, and chunks small enough that
+// they split mid-stream.
+void WriteBag(const std::string& path,
+              rosbag::compression::CompressionType compression,
+              uint32_t chunk_threshold, bool shuffle,
+              bool noisy_images = false) {
+  rosbag::Bag bag(path, rosbag::bagmode::Write);
+  bag.setCompression(compression);
+  bag.setChunkThreshold(chunk_threshold);
+  std::mt19937 rng(5);
+  ros::M_string other_publisher;
+  other_publisher["callerid"] = "/imu_driver_2";
+  other_publisher["topic"] = "/imu";
+  other_publisher["type"] = ros::message_traits::datatype<sensor_msgs::Imu>();
+  other_publisher["md5sum"] = ros::message_traits::md5sum<sensor_msgs::Imu>();
+  other_publisher["message_definition"] =
+      ros::message_traits::definition<sensor_msgs::Imu>();
+  const ros::Time t0(1700000000, 0);
+  for (int i = 0; i < 60; ++i) {
+    const ros::Time ti = t0 + ros::Duration(i / 30.0);
+    for (int k = 0; k < 7; ++k) {
+      sensor_msgs::Imu imu;
+      imu.header.seq = i * 7 + k;
+      imu.angular_velocity.x = 0.01 * k;
+      ros::Time tk = t0 + ros::Duration(0.005 * (i * 7 + k));
+      if (shuffle && rng() % 11 == 0)
+        tk -= ros::Duration(0.02);  // late arrival
+      if (k == 3) {
+        bag.write("/imu", tk, imu,
+                  boost::make_shared<ros::M_string>(other_publisher));
+      } else {
+        bag.write("/imu", tk, imu);
+      }
+    }
+    sensor_msgs::CameraInfo info;
+    info.header.seq = i;
+    info.width = 16;
+    bag.write("camera/camera_info", ti, info);
+    bag.write("/camera/image_raw", ti, MakeImage(i, noisy_images));
+  }
+  bag.close();
+}
+
+struct Case {
+  rosbag::compression::CompressionType compression;
+  uint32_t chunk_threshold;
+  bool shuffle;
+};
+
+class IndexedBagReaderOrderTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(IndexedBagReaderOrderTest, SameMessagesAndOrderAsRosbagView) {
+  TempDir dir;
+  const std::string path = dir.File("order.bag");
+  WriteBag(path, GetParam().compression, GetParam().chunk_threshold,
+           GetParam().shuffle);
+  for (const std::vector<std::string>& topics :
+       {std::vector<std::string>{"/imu", "/camera/image_raw",
+                                 "camera/camera_info"},
+        std::vector<std::string>{"/imu", "imu", "/camera/image_raw",
+                                 "camera/image_raw"},
+        std::vector<std::string>{"/camera/image_raw"},
+        std::vector<std::string>{"nothing"}}) {
+    const std::vector<Seen> want = ReadWithView(path, topics);
+    for (bool verify : {false, true}) {
+      std::string error;
+      const std::vector<Seen> got = ReadIndexed(path, topics, verify, &error);
+      EXPECT_TRUE(error.empty()) << error;
+      ASSERT_EQ(got.size(), want.size()) << topics.front();
+      for (size_t i = 0; i < want.size(); ++i) {
+        ASSERT_TRUE(got[i] == want[i])
+            << "message " << i << ": " << got[i].topic << " at " << got[i].time
+            << " against " << want[i].topic << " at " << want[i].time;
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Bags, IndexedBagReaderOrderTest,
+    ::testing::Values(Case{rosbag::compression::Uncompressed, 768 * 1024,
+                           false},
+                      Case{rosbag::compression::LZ4, 768 * 1024, false},
+                      Case{rosbag::compression::LZ4, 1500, true},
+                      Case{rosbag::compression::Uncompressed, 1500, true},
+                      Case{rosbag::compression::LZ4, 1, true}));
+
+TEST(IndexedBagReaderTest, TheBagMatchesWhatWasWritten) {
+  // Not only the same as View: the image bytes deserialize to the image.
+  TempDir dir;
+  const std::string path = dir.File("content.bag");
+  WriteBag(path, rosbag::compression::LZ4, 4000, false);
+  IndexedBagReader reader;
+  std::string why;
+  ASSERT_TRUE(reader.Open(path, &why)) << why;
+  reader.Select({"/camera/image_raw"});
+  IndexedBagReader::Message m;
+  std::string error;
+  int n = 0;
+  while (reader.Next(&m, &error)) {
+    EXPECT_EQ(reader.connections().at(m.connection).datatype,
+              "sensor_msgs/Image");
+    sensor_msgs::Image im;
+    ros::serialization::IStream s(const_cast<uint8_t*>(m.data), m.size);
+    ros::serialization::deserialize(s, im);
+    const sensor_msgs::Image want = MakeImage(n);
+    EXPECT_EQ(im.header.seq, want.header.seq);
+    EXPECT_EQ(im.width, want.width);
+    EXPECT_EQ(im.data, want.data);
+    EXPECT_EQ(m.time, ros::Time(1700000000, 0) + ros::Duration(n / 30.0));
+    ++n;
+  }
+  EXPECT_TRUE(error.empty()) << error;
+  EXPECT_EQ(n, 60);
+}
+
+TEST(IndexedBagReaderTest, RefusesWhatItDoesNotRead) {
+  TempDir dir;
+  IndexedBagReader reader;
+  std::string why;
+  // BZ2 chunks: the caller reads them through rosbag::View.
+  const std::string bz2 = dir.File("bz2.bag");
+  WriteBag(bz2, rosbag::compression::BZ2, 768 * 1024, false);
+  EXPECT_FALSE(reader.Open(bz2, &why));
+  EXPECT_NE(why.find("bz2"), std::string::npos) << why;
+  EXPECT_FALSE(reader.Open(dir.File("missing.bag"), &why));
+  EXPECT_NE(why.find("cannot open"), std::string::npos) << why;
+  const std::string text = dir.File("text.bag");
+  std::ofstream(text) << "not a bag\n";
+  EXPECT_FALSE(reader.Open(text, &why));
+  EXPECT_NE(why.find("version 2.0"), std::string::npos) << why;
+}
+
+std::vector<char> Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<char>((std::istreambuf_iterator<char>(in)),
+                           std::istreambuf_iterator<char>());
+}
+
+void Spill(const std::string& path, const std::vector<char>& bytes) {
+  std::ofstream(path, std::ios::binary).write(bytes.data(), bytes.size());
+}
+
+TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
+  TempDir dir;
+  const std::string good = dir.File("good.bag");
+  WriteBag(good, rosbag::compression::LZ4, 8000, false, /*noisy_images=*/true);
+  const std::vector<char> bytes = Slurp(good);
+  ASSERT_GT(bytes.size(), 200000u);
+  // Cut anywhere: either refused at Open (the index is at the end) or, if
+  // the cut leaves the index, an error while reading.
+  for (size_t cut :
+       {size_t{20}, size_t{4200}, bytes.size() / 2, bytes.size() - 10}) {
+    const std::string path = dir.File("cut.bag");
+    Spill(path, std::vector<char>(bytes.begin(), bytes.begin() + cut));
+    IndexedBagReader reader;
+    std::string why;
+    EXPECT_FALSE(reader.Open(path, &why)) << "cut at " << cut;
+    EXPECT_FALSE(why.empty());
+  }
+  // Noise over the first half of the file, which is mostly LZ4 chunk data
+  // (pseudo-random images do not compress): every Next either gives a
+  // message within its chunk or stops with an error, and a corrupt chunk
+  // is noticed (nothing past the buffers is read: valgrind shows that too).
+  int errors[2] = {0, 0};  // without, with the checksums
+  for (bool verify : {false, true}) {
+    std::mt19937 rng(3);
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<char> noisy = bytes;
+      for (int k = 0; k < 30; ++k) {
+        const size_t at = 4200 + rng() % (noisy.size() / 2);
+        noisy[at] = static_cast<char>(rng());
+      }
+      const std::string path = dir.File("noisy.bag");
+      Spill(path, noisy);
+      IndexedBagReader reader(verify);
+      std::string why;
+      if (!reader.Open(path, &why)) continue;
+      reader.Select({"/imu", "/camera/image_raw", "camera/camera_info"});
+      IndexedBagReader::Message m;
+      std::string error;
+      int n = 0;
+      while (reader.Next(&m, &error) && n < 100000) ++n;
+      if (!error.empty()) ++errors[verify];
+    }
+  }
+  EXPECT_GT(errors[0], 0)
+      << "noise in LZ4 chunks went unnoticed in every trial";
+  // The checksums notice at least whatever the bounds checks notice.
+  EXPECT_GE(errors[1], errors[0]);
+  EXPECT_GT(errors[1], 0);
+}
+
+}  // namespace
+}  // namespace steadiface_bag

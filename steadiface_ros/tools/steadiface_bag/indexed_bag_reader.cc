@@ -1,0 +1,409 @@
+#include "steadiface_bag/indexed_bag_reader.h"
+
+#include <fcntl.h>
+#include <lz4frame.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstring>
+
+namespace steadiface_bag {
+namespace {
+
+// Record op codes of the bag format 2.0.
+constexpr uint8_t kOpMessageDefinition = 0x01;  // version 1.2 only
+constexpr uint8_t kOpMessageData = 0x02;
+constexpr uint8_t kOpFileHeader = 0x03;
+constexpr uint8_t kOpIndexData = 0x04;
+constexpr uint8_t kOpChunk = 0x05;
+constexpr uint8_t kOpChunkInfo = 0x06;
+constexpr uint8_t kOpConnection = 0x07;
+constexpr char kVersionLine[] = "#ROSBAG V2.0\n";
+
+uint32_t U32(const uint8_t* p) {
+  uint32_t v;
+  std::memcpy(&v, p, 4);
+  return v;
+}
+
+// One record: header fields, and the data after them.
+struct Record {
+  std::map<std::string, std::string> fields;
+  const uint8_t* data = nullptr;
+  uint32_t data_size = 0;
+  uint64_t total_size = 0;  // both length words, header and data
+
+  bool Has(const char* name) const { return fields.count(name) != 0; }
+  bool Op(uint8_t* op) const {
+    auto it = fields.find("op");
+    if (it == fields.end() || it->second.size() != 1) return false;
+    *op = static_cast<uint8_t>(it->second[0]);
+    return true;
+  }
+  bool Uint32(const char* name, uint32_t* v) const {
+    auto it = fields.find(name);
+    if (it == fields.end() || it->second.size() != 4) return false;
+    std::memcpy(v, it->second.data(), 4);
+    return true;
+  }
+  bool Uint64(const char* name, uint64_t* v) const {
+    auto it = fields.find(name);
+    if (it == fields.end() || it->second.size() != 8) return false;
+    std::memcpy(v, it->second.data(), 8);
+    return true;
+  }
+  bool Time(const char* name, ros::Time* t) const {
+    auto it = fields.find(name);
+    if (it == fields.end() || it->second.size() != 8) return false;
+    const uint8_t* p = reinterpret_cast<const uint8_t*>(it->second.data());
+    *t = ros::Time(U32(p), U32(p + 4));
+    return true;
+  }
+  bool String(const char* name, std::string* s) const {
+    auto it = fields.find(name);
+    if (it == fields.end()) return false;
+    *s = it->second;
+    return true;
+  }
+};
+
+// "name=value" fields, each behind its 32-bit length.
+bool ParseFields(const uint8_t* p, uint64_t size,
+                 std::map<std::string, std::string>* fields) {
+  uint64_t q = 0;
+  while (q < size) {
+    if (size - q < 4) return false;
+    const uint32_t len = U32(p + q);
+    q += 4;
+    if (len > size - q) return false;
+    const char* f = reinterpret_cast<const char*>(p + q);
+    const char* eq = static_cast<const char*>(std::memchr(f, '=', len));
+    if (eq == nullptr) return false;
+    (*fields)[std::string(f, eq)] = std::string(eq + 1, f + len);
+    q += len;
+  }
+  return true;
+}
+
+// The record at `pos` of a buffer of `size` bytes.
+bool ParseRecord(const uint8_t* buf, uint64_t size, uint64_t pos, Record* r) {
+  if (pos > size || size - pos < 4) return false;
+  const uint32_t header_len = U32(buf + pos);
+  uint64_t q = pos + 4;
+  if (header_len > size - q) return false;
+  const uint8_t* header = buf + q;
+  q += header_len;
+  if (size - q < 4) return false;
+  const uint32_t data_len = U32(buf + q);
+  q += 4;
+  if (data_len > size - q) return false;
+  r->fields.clear();
+  if (!ParseFields(header, header_len, &r->fields)) return false;
+  r->data = buf + q;
+  r->data_size = data_len;
+  r->total_size = 8ull + header_len + data_len;
+  return true;
+}
+
+}  // namespace
+
+struct IndexedBagReader::Lz4Context {
+  LZ4F_dctx* ctx = nullptr;
+  Lz4Context() { LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION); }
+  ~Lz4Context() { LZ4F_freeDecompressionContext(ctx); }
+};
+
+IndexedBagReader::IndexedBagReader(bool verify_checksums)
+    : verify_checksums_(verify_checksums), lz4_(new Lz4Context) {}
+
+IndexedBagReader::~IndexedBagReader() { Unmap(); }
+
+void IndexedBagReader::Release(const Chunk& c) {
+  const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
+  const uintptr_t begin = reinterpret_cast<uintptr_t>(c.data) & ~(page - 1);
+  const uintptr_t end = reinterpret_cast<uintptr_t>(c.data) + c.stored_size;
+  madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+}
+
+void IndexedBagReader::Unmap() {
+  if (file_ != nullptr) munmap(const_cast<uint8_t*>(file_), file_size_);
+  file_ = nullptr;
+  file_size_ = 0;
+}
+
+bool IndexedBagReader::Open(const std::string& path, std::string* why) {
+  Unmap();
+  connections_.clear();
+  indexes_.clear();
+  chunks_.clear();
+  ranges_.clear();
+  cursors_.clear();
+  started_ = false;
+  cached_pos_ = UINT64_MAX;
+  last_pos_ = UINT64_MAX;
+  if (lz4_->ctx == nullptr) {
+    *why = "no LZ4 decompression context";
+    return false;
+  }
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    *why = "cannot open " + path + ": " + std::strerror(errno);
+    return false;
+  }
+  struct stat st;
+  if (fstat(fd, &st) != 0 || st.st_size <= 0) {
+    close(fd);
+    *why = "cannot size " + path;
+    return false;
+  }
+  void* m = mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ,
+                 MAP_PRIVATE, fd, 0);
+  close(fd);
+  if (m == MAP_FAILED) {
+    *why = "cannot map " + path + ": " + std::strerror(errno);
+    return false;
+  }
+  file_ = static_cast<const uint8_t*>(m);
+  file_size_ = static_cast<uint64_t>(st.st_size);
+  // Read in order, mostly: let the kernel read ahead.
+  madvise(m, file_size_, MADV_SEQUENTIAL);
+  if (!ReadIndex(why)) {
+    Unmap();
+    return false;
+  }
+  return true;
+}
+
+bool IndexedBagReader::ReadIndex(std::string* why) {
+  const size_t vlen = sizeof(kVersionLine) - 1;
+  if (file_size_ < vlen || std::memcmp(file_, kVersionLine, vlen) != 0) {
+    *why = "not a version 2.0 bag";
+    return false;
+  }
+  Record r;
+  uint8_t op = 0;
+  if (!ParseRecord(file_, file_size_, vlen, &r) || !r.Op(&op) ||
+      op != kOpFileHeader) {
+    *why = "no bag header record";
+    return false;
+  }
+  uint64_t index_pos = 0;
+  uint32_t conn_count = 0, chunk_count = 0;
+  if (!r.Uint64("index_pos", &index_pos) ||
+      !r.Uint32("conn_count", &conn_count) ||
+      !r.Uint32("chunk_count", &chunk_count)) {
+    *why = "bag header without index_pos/conn_count/chunk_count";
+    return false;
+  }
+  std::string encryptor;
+  if (r.String("encryptor", &encryptor) && !encryptor.empty() &&
+      encryptor != "rosbag/NoEncryptor") {
+    *why = "encrypted bag (" + encryptor + ")";
+    return false;
+  }
+  if (index_pos == 0 || index_pos >= file_size_) {
+    *why = "unindexed bag (rosbag reindex it)";
+    return false;
+  }
+  // Connection records, then chunk info records, at index_pos.
+  uint64_t pos = index_pos;
+  for (uint32_t i = 0; i < conn_count; ++i) {
+    uint32_t id = 0;
+    Connection c;
+    std::map<std::string, std::string> conn_header;
+    if (!ParseRecord(file_, file_size_, pos, &r) || !r.Op(&op) ||
+        op != kOpConnection || !r.Uint32("conn", &id) ||
+        !r.String("topic", &c.topic) ||
+        !ParseFields(r.data, r.data_size, &conn_header)) {
+      *why = "bad connection record in the index";
+      return false;
+    }
+    auto type = conn_header.find("type");
+    if (type != conn_header.end()) c.datatype = type->second;
+    connections_[id] = c;
+    pos += r.total_size;
+  }
+  std::vector<std::pair<uint64_t, uint32_t>>
+      chunk_infos;  // position, connections
+  for (uint32_t i = 0; i < chunk_count; ++i) {
+    uint64_t chunk_pos = 0;
+    uint32_t count = 0;
+    if (!ParseRecord(file_, file_size_, pos, &r) || !r.Op(&op) ||
+        op != kOpChunkInfo || !r.Uint64("chunk_pos", &chunk_pos) ||
+        !r.Uint32("count", &count)) {
+      *why = "bad chunk info record in the index";
+      return false;
+    }
+    chunk_infos.emplace_back(chunk_pos, count);
+    pos += r.total_size;
+  }
+  // Each chunk, and the connection index records right after it: one
+  // multiset per connection, filled in chunk order as rosbag does.
+  for (const auto& ci : chunk_infos) {
+    Chunk chunk;
+    chunk.pos = ci.first;
+    if (!ParseRecord(file_, file_size_, ci.first, &r) || !r.Op(&op) ||
+        op != kOpChunk || !r.String("compression", &chunk.compression) ||
+        !r.Uint32("size", &chunk.size)) {
+      *why = "bad chunk record";
+      return false;
+    }
+    if (chunk.compression != "none" && chunk.compression != "lz4") {
+      *why = "chunks compressed with " + chunk.compression;
+      return false;
+    }
+    chunk.data = r.data;
+    chunk.stored_size = r.data_size;
+    if (chunk.compression == "none" && chunk.size != chunk.stored_size) {
+      *why = "uncompressed chunk of the wrong size";
+      return false;
+    }
+    uint64_t q = ci.first + r.total_size;
+    for (uint32_t k = 0; k < ci.second; ++k) {
+      uint32_t ver = 0, conn = 0, count = 0;
+      if (!ParseRecord(file_, file_size_, q, &r) || !r.Op(&op) ||
+          op != kOpIndexData || !r.Uint32("ver", &ver) || ver != 1 ||
+          !r.Uint32("conn", &conn) || !r.Uint32("count", &count) ||
+          r.data_size / 12 < count) {
+        *why = "bad connection index record";
+        return false;
+      }
+      Index& index = indexes_[conn];
+      for (uint32_t e = 0; e < count; ++e) {
+        const uint8_t* p = r.data + 12ull * e;
+        IndexEntry entry;
+        entry.time = ros::Time(U32(p), U32(p + 4));
+        entry.chunk_pos = ci.first;
+        entry.offset = U32(p + 8);
+        if (entry.offset >= chunk.size) {
+          *why = "index entry outside its chunk";
+          return false;
+        }
+        index.insert(index.end(), entry);
+      }
+      q += r.total_size;
+    }
+    chunks_[chunk.pos] = chunk;
+  }
+  return true;
+}
+
+void IndexedBagReader::Select(const std::vector<std::string>& topics) {
+  ranges_.clear();
+  cursors_.clear();
+  started_ = false;
+  // View::updateQueries: connections in id order, those with an index.
+  for (const auto& c : connections_) {
+    if (std::find(topics.begin(), topics.end(), c.second.topic) == topics.end())
+      continue;
+    auto it = indexes_.find(c.first);
+    if (it == indexes_.end() || it->second.empty()) continue;
+    ranges_.push_back(Range{it->second.begin(), it->second.end(), c.first});
+  }
+}
+
+const uint8_t* IndexedBagReader::ChunkData(uint64_t pos, uint32_t* size,
+                                           std::string* error) {
+  auto it = chunks_.find(pos);
+  if (it == chunks_.end()) {
+    *error = "index points to no chunk";
+    return nullptr;
+  }
+  const Chunk& c = it->second;
+  *size = c.size;
+  if (last_pos_ != pos) {
+    // Moving to another chunk: let go of the last one's pages, so the
+    // resident size stays about one chunk whatever the bag's size (they
+    // are read again from the page cache if View's order comes back).
+    auto last = chunks_.find(last_pos_);
+    if (last != chunks_.end()) Release(last->second);
+    last_pos_ = pos;
+  }
+  if (c.compression == "none") return c.data;
+  if (cached_pos_ == pos) return cached_.data();
+  cached_pos_ = UINT64_MAX;
+  cached_.resize(c.size);
+  LZ4F_decompressOptions_t options;
+  std::memset(&options, 0, sizeof(options));
+  options.skipChecksums = verify_checksums_ ? 0 : 1;
+  size_t out = 0, in = 0;
+  size_t hint = 1;
+  // One frame per chunk; the loop covers a decoder that stops early.
+  while (hint != 0 && in < c.stored_size && out < c.size) {
+    size_t dst = c.size - out, src = c.stored_size - in;
+    hint = LZ4F_decompress(lz4_->ctx, cached_.data() + out, &dst, c.data + in,
+                           &src, &options);
+    if (LZ4F_isError(hint)) {
+      *error = std::string("LZ4 chunk: ") + LZ4F_getErrorName(hint);
+      LZ4F_resetDecompressionContext(lz4_->ctx);
+      return nullptr;
+    }
+    out += dst;
+    in += src;
+    if (dst == 0 && src == 0) break;
+  }
+  LZ4F_resetDecompressionContext(lz4_->ctx);
+  if (out != c.size) {
+    *error = "LZ4 chunk decompressed to the wrong size";
+    return nullptr;
+  }
+  cached_pos_ = pos;
+  return cached_.data();
+}
+
+bool IndexedBagReader::Next(Message* m, std::string* error) {
+  error->clear();
+  // View::iterator: the cursor with the earliest time is the last one after
+  // a sort by descending time; advance it, drop it at its end, sort again.
+  auto later = [](const Cursor& a, const Cursor& b) {
+    return a.iter->time > b.iter->time;
+  };
+  if (!started_) {
+    started_ = true;
+    for (const Range& r : ranges_) {
+      if (r.begin != r.end) cursors_.push_back(Cursor{r.begin, &r});
+    }
+    std::sort(cursors_.begin(), cursors_.end(), later);
+  } else if (!cursors_.empty()) {
+    Cursor& back = cursors_.back();
+    ++back.iter;
+    if (back.iter == back.range->end) cursors_.pop_back();
+    std::sort(cursors_.begin(), cursors_.end(), later);
+  }
+  if (cursors_.empty()) return false;
+  const Cursor& cur = cursors_.back();
+  uint32_t chunk_size = 0;
+  const uint8_t* chunk = ChunkData(cur.iter->chunk_pos, &chunk_size, error);
+  if (chunk == nullptr) {
+    cursors_.clear();
+    return false;
+  }
+  // The message data record at the offset (connection records before it
+  // are skipped, as rosbag does).
+  uint64_t q = cur.iter->offset;
+  Record r;
+  uint8_t op = 0;
+  for (;;) {
+    if (!ParseRecord(chunk, chunk_size, q, &r) || !r.Op(&op)) {
+      *error = "bad record in a chunk";
+      cursors_.clear();
+      return false;
+    }
+    if (op != kOpConnection && op != kOpMessageDefinition) break;
+    q += r.total_size;
+  }
+  if (op != kOpMessageData) {
+    *error = "index entry does not point to a message";
+    cursors_.clear();
+    return false;
+  }
+  m->connection = cur.range->connection;
+  m->time = cur.iter->time;
+  m->data = r.data;
+  m->size = r.data_size;
+  return true;
+}
+
+}  // namespace steadiface_bag
