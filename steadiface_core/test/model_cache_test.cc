@@ -4,12 +4,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <dlib/image_processing/shape_predictor.h>
+#include <dlib/opencv/cv_image.h>
 #include <gtest/gtest.h>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -24,6 +27,41 @@ namespace {
 
 using testing_util::LoadImage;
 
+// Our cascade (on the packed trees) against dlib's own shape_predictor on a
+// real photo, for boxes around the face and off it (other leaves): every
+// part dlib reports (rounded to whole pixels by dlib) is ours rounded the
+// same way.
+TEST(LandmarkPredictorTest, SameLandmarksAsDlibsShapePredictor) {
+  dlib::shape_predictor sp;
+  dlib::deserialize(kDefaultShapePredictorPath) >> sp;
+  std::unique_ptr<LandmarkPredictor> p;
+  ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "").ok());
+  cv::Mat grey;
+  cv::cvtColor(LoadImage("astronaut.png"), grey, cv::COLOR_BGR2GRAY);
+  dlib::cv_image<unsigned char> img(grey);
+  int compared = 0;
+  for (const cv::Rect2d& box :
+       {cv::Rect2d(139, 38, 168, 188), cv::Rect2d(120, 20, 200, 200),
+        cv::Rect2d(160, 70, 120, 140), cv::Rect2d(10, 200, 150, 150),
+        cv::Rect2d(300, 300, 90, 60)}) {
+    std::vector<Eigen::Vector2d> ours;
+    ASSERT_TRUE(p->Predict(grey, box, &ours).ok());
+    const dlib::rectangle r(
+        static_cast<long>(std::lround(box.x)),
+        static_cast<long>(std::lround(box.y)),
+        static_cast<long>(std::lround(box.x + box.width - 1)),
+        static_cast<long>(std::lround(box.y + box.height - 1)));
+    const dlib::full_object_detection d = sp(img, r);
+    ASSERT_EQ(ours.size(), d.num_parts());
+    for (unsigned long i = 0; i < d.num_parts(); ++i) {
+      EXPECT_EQ(std::floor(ours[i].x() + 0.5), d.part(i).x()) << "part " << i;
+      EXPECT_EQ(std::floor(ours[i].y() + 0.5), d.part(i).y()) << "part " << i;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 5 * 68);
+}
+
 // The decoded-model cache gives the very same model: identical landmarks
 // to the last bit on a real photo; a damaged cache file is ignored and
 // rewritten.
@@ -37,18 +75,21 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
   std::vector<Eigen::Vector2d> reference, cached;
   {
     std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "").ok());
+    ASSERT_TRUE(
+        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "").ok());
     EXPECT_FALSE(p->loaded_from_cache());
     ASSERT_TRUE(p->Predict(grey, box, &reference).ok());
   }
   {
     std::unique_ptr<LandmarkPredictor> p;  // decodes the .dat, writes the cache
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+    ASSERT_TRUE(
+        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
     EXPECT_FALSE(p->loaded_from_cache());
   }
   {
     std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+    ASSERT_TRUE(
+        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
     EXPECT_TRUE(p->loaded_from_cache());
     ASSERT_TRUE(p->Predict(grey, box, &cached).ok());
   }
@@ -67,20 +108,24 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
   ASSERT_EQ(truncate(files[0].c_str(), full_size / 2), 0);
   {
     std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+    ASSERT_TRUE(
+        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
     EXPECT_FALSE(p->loaded_from_cache());
   }
   ASSERT_EQ(stat(files[0].c_str(), &st), 0);
   EXPECT_EQ(st.st_size, full_size);
   {
     std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+    ASSERT_TRUE(
+        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
     EXPECT_TRUE(p->loaded_from_cache());
   }
   // An unwritable cache directory is not an error.
   {
     std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "/proc/steadiface").ok());
+    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p,
+                                        "/proc/steadiface")
+                    .ok());
     EXPECT_FALSE(p->loaded_from_cache());
   }
   std::remove(files[0].c_str());
@@ -113,7 +158,8 @@ TEST(FaceDetectorTest, CachedDetectorFindsTheSameFaces) {
   std::vector<FaceBox> fresh, cached, repaired;
   detect(&fresh);  // decodes dlib's detector, writes the cache
   std::vector<cv::String> files;
-  cv::glob(std::string(dir_template) + "/frontal_face_detector_*.sfcache", files, false);
+  cv::glob(std::string(dir_template) + "/frontal_face_detector_*.sfcache",
+           files, false);
   ASSERT_EQ(files.size(), 1u);
   std::string written;
   ASSERT_TRUE(ReadWholeFile(files[0], &written));

@@ -33,7 +33,75 @@ struct LandmarkPredictor::Impl {
   std::vector<std::vector<unsigned long>> anchor_idx;
   std::vector<std::vector<dlib::vector<float, 2>>> deltas;
   unsigned long num_parts() const { return initial_shape.size() / 2; }
+
+  // The same trees packed (Pack()): a fit walks 5000 trees and reads one
+  // leaf of each, and dlib keeps every leaf in its own heap block and
+  // every split node in 24 bytes. Packed, the leaves are one contiguous,
+  // cache-line-aligned block in tree order and each tree's splits one
+  // 12-byte record per node. Empty when the model's trees are not all
+  // alike (then dlib's own structures are walked).
+  struct Split {
+    uint32_t idx1, idx2;
+    float thresh;
+  };
+  std::vector<Split>
+      splits;  // cascade c, tree t: from (c * trees + t) * splits_per_tree
+  float* leaves =
+      nullptr;  // ... leaf l: ((c * trees + t) * leaves_per_tree + l) * n
+  size_t leaves_bytes = 0;
+  size_t trees = 0, splits_per_tree = 0, leaves_per_tree = 0;
+  bool packed() const { return leaves != nullptr; }
+  void Pack();
+  ~Impl() { std::free(leaves); }
 };
+
+void LandmarkPredictor::Impl::Pack() {
+  const size_t n = initial_shape.size();
+  if (forests.empty() || forests[0].empty() || n == 0) return;
+  trees = forests[0].size();
+  splits_per_tree = forests[0][0].splits.size();
+  leaves_per_tree = forests[0][0].leaf_values.size();
+  if (leaves_per_tree != splits_per_tree + 1) return;
+  for (const auto& forest : forests) {
+    if (forest.size() != trees) return;
+    for (const auto& tree : forest) {
+      if (tree.splits.size() != splits_per_tree ||
+          tree.leaf_values.size() != leaves_per_tree) {
+        return;
+      }
+      for (const auto& leaf : tree.leaf_values) {
+        if (static_cast<size_t>(leaf.size()) != n) return;
+      }
+      for (const auto& sp : tree.splits) {
+        if (sp.idx1 > UINT32_MAX || sp.idx2 > UINT32_MAX) return;
+      }
+    }
+  }
+  constexpr size_t kLine = 64;
+  const size_t floats = forests.size() * trees * leaves_per_tree * n;
+  leaves_bytes = (floats * sizeof(float) + kLine - 1) / kLine * kLine;
+  leaves = static_cast<float*>(std::aligned_alloc(kLine, leaves_bytes));
+  if (leaves == nullptr) return;
+  splits.reserve(forests.size() * trees * splits_per_tree);
+  float* dst = leaves;
+  for (auto& forest : forests) {
+    for (auto& tree : forest) {
+      for (const auto& sp : tree.splits) {
+        splits.push_back(Split{static_cast<uint32_t>(sp.idx1),
+                               static_cast<uint32_t>(sp.idx2), sp.thresh});
+      }
+      for (const auto& leaf : tree.leaf_values) {
+        std::memcpy(dst, &leaf(0), n * sizeof(float));
+        dst += n;
+      }
+      // The packed copy is the one used: do not hold the model twice.
+      tree.leaf_values.clear();
+      tree.leaf_values.shrink_to_fit();
+      tree.splits.clear();
+      tree.splits.shrink_to_fit();
+    }
+  }
+}
 
 namespace {
 
@@ -54,14 +122,15 @@ bool StatSource(const std::string& path, SourceKey* key) {
   key->canonical = real != nullptr ? real : path;
   std::free(real);
   key->size = static_cast<uint64_t>(st.st_size);
-  key->mtime_ns = static_cast<int64_t>(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec;
+  key->mtime_ns =
+      static_cast<int64_t>(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec;
   return true;
 }
 
 std::string CacheFile(const std::string& dir, const SourceKey& key) {
   std::ostringstream name;
-  name << dir << "/landmarks_" << std::hex << std::hash<std::string>()(key.canonical)
-       << ".sfcache";
+  name << dir << "/landmarks_" << std::hex
+       << std::hash<std::string>()(key.canonical) << ".sfcache";
   return name.str();
 }
 
@@ -74,7 +143,8 @@ class CacheWriter {
   }
   void Floats(const float* p, uint64_t n) {
     Pod(n);
-    out_->write(reinterpret_cast<const char*>(p), static_cast<std::streamsize>(n * sizeof(float)));
+    out_->write(reinterpret_cast<const char*>(p),
+                static_cast<std::streamsize>(n * sizeof(float)));
   }
 
  private:
@@ -93,7 +163,8 @@ class CacheReader {
   }
   // A count of elements of `element_bytes` each that must fit in the rest.
   bool Count(uint64_t* n, size_t element_bytes) {
-    return Pod(n) && *n <= static_cast<uint64_t>(end_ - p_) / std::max<size_t>(1, element_bytes);
+    return Pod(n) && *n <= static_cast<uint64_t>(end_ - p_) /
+                               std::max<size_t>(1, element_bytes);
   }
   bool Floats(float* dst, uint64_t n) {
     if (static_cast<uint64_t>(end_ - p_) < n * sizeof(float)) return false;
@@ -149,7 +220,8 @@ Status LandmarkPredictor::Load(const std::string& path,
   auto impl = std::make_shared<Impl>();
   SourceKey key;
   const bool cacheable = !cache_dir.empty() && StatSource(path, &key);
-  const std::string cache_file = cacheable ? CacheFile(cache_dir, key) : std::string();
+  const std::string cache_file =
+      cacheable ? CacheFile(cache_dir, key) : std::string();
   // The decoded model from the cache, if it is this model's.
   auto read_cache = [&](Impl* m) {
     std::string buf;
@@ -164,7 +236,8 @@ Status LandmarkPredictor::Load(const std::string& path,
     }
     if (std::memcmp(magic, kCacheMagic, sizeof(magic)) != 0 || !r.Pod(&size) ||
         !r.Pod(&mtime) || !r.Count(&len, 1) || !r.Bytes(&canonical, len) ||
-        size != key.size || mtime != key.mtime_ns || canonical != key.canonical) {
+        size != key.size || mtime != key.mtime_ns ||
+        canonical != key.canonical) {
       return false;
     }
     uint64_t n_shape = 0, n_cascades = 0;
@@ -230,8 +303,10 @@ Status LandmarkPredictor::Load(const std::string& path,
       w.Pod(key.size);
       w.Pod(key.mtime_ns);
       w.Pod(static_cast<uint64_t>(key.canonical.size()));
-      out.write(key.canonical.data(), static_cast<std::streamsize>(key.canonical.size()));
-      w.Floats(&m.initial_shape(0), static_cast<uint64_t>(m.initial_shape.size()));
+      out.write(key.canonical.data(),
+                static_cast<std::streamsize>(key.canonical.size()));
+      w.Floats(&m.initial_shape(0),
+               static_cast<uint64_t>(m.initial_shape.size()));
       w.Pod(static_cast<uint64_t>(m.forests.size()));
       for (size_t c = 0; c < m.forests.size(); ++c) {
         w.Pod(static_cast<uint64_t>(m.forests[c].size()));
@@ -244,7 +319,8 @@ Status LandmarkPredictor::Load(const std::string& path,
           }
           w.Pod(static_cast<uint64_t>(tree.leaf_values.size()));
           for (const auto& leaf : tree.leaf_values) {
-            w.Floats(leaf.size() > 0 ? &leaf(0) : nullptr, static_cast<uint64_t>(leaf.size()));
+            w.Floats(leaf.size() > 0 ? &leaf(0) : nullptr,
+                     static_cast<uint64_t>(leaf.size()));
           }
         }
         w.Pod(static_cast<uint64_t>(m.anchor_idx[c].size()));
@@ -260,8 +336,10 @@ Status LandmarkPredictor::Load(const std::string& path,
     }
   };
   if (cacheable && read_cache(impl.get()) && impl->num_parts() == 68 &&
-      !impl->forests.empty() && impl->forests.size() == impl->anchor_idx.size() &&
+      !impl->forests.empty() &&
+      impl->forests.size() == impl->anchor_idx.size() &&
       impl->forests.size() == impl->deltas.size()) {
+    impl->Pack();
     p->impl_ = impl;
     p->from_cache_ = true;
     {
@@ -300,6 +378,7 @@ Status LandmarkPredictor::Load(const std::string& path,
                          " points; steadiface needs the 68-point model" + hint);
   }
   if (cacheable) write_cache(*impl);
+  impl->Pack();
   p->impl_ = impl;
   {
     std::lock_guard<std::mutex> lock(cache_mutex);
@@ -313,8 +392,9 @@ int LandmarkPredictor::num_parts() const {
   return static_cast<int>(impl_->num_parts());
 }
 
-Status LandmarkPredictor::Predict(const cv::Mat& gray, const cv::Rect2d& box,
-                                  std::vector<Eigen::Vector2d>* landmarks) const {
+Status LandmarkPredictor::Predict(
+    const cv::Mat& gray, const cv::Rect2d& box,
+    std::vector<Eigen::Vector2d>* landmarks) const {
   if (gray.empty() || gray.type() != CV_8UC1) {
     return Status::Error("landmarks: need an 8-bit single-channel image");
   }
@@ -322,10 +402,11 @@ Status LandmarkPredictor::Predict(const cv::Mat& gray, const cv::Rect2d& box,
     return Status::Error("landmarks: face box too small");
   }
   dlib::cv_image<unsigned char> img(gray);
-  const dlib::rectangle r(static_cast<long>(std::lround(box.x)),
-                          static_cast<long>(std::lround(box.y)),
-                          static_cast<long>(std::lround(box.x + box.width - 1)),
-                          static_cast<long>(std::lround(box.y + box.height - 1)));
+  const dlib::rectangle r(
+      static_cast<long>(std::lround(box.x)),
+      static_cast<long>(std::lround(box.y)),
+      static_cast<long>(std::lround(box.x + box.width - 1)),
+      static_cast<long>(std::lround(box.y + box.height - 1)));
   const Impl& m = *impl_;
   dlib::matrix<float, 0, 1> shape = m.initial_shape;
   thread_local std::vector<float> features;
@@ -343,11 +424,27 @@ Status LandmarkPredictor::Predict(const cv::Mat& gray, const cv::Rect2d& box,
     // dlib's (bit-identical), each leaf fetched from memory a few leaves
     // ahead: the ~4 MB of leaves a fit touches in the 65 MB model are what
     // the predictor waits on.
-    const auto& forest = m.forests[iter];
-    leaves.resize(forest.size());
-    for (size_t i = 0; i < forest.size(); ++i) {
-      unsigned long leaf = 0;
-      leaves[i] = &forest[i](features, leaf)(0);
+    if (m.packed()) {
+      // dlib's regression_tree::operator() on the packed splits.
+      const Impl::Split* sp = &m.splits[iter * m.trees * m.splits_per_tree];
+      const float* lv = m.leaves + iter * m.trees * m.leaves_per_tree * n;
+      const float* f = features.data();
+      leaves.resize(m.trees);
+      for (size_t t = 0; t < m.trees; ++t, sp += m.splits_per_tree) {
+        size_t i = 0;
+        while (i < m.splits_per_tree) {
+          i = f[sp[i].idx1] - f[sp[i].idx2] > sp[i].thresh ? 2 * i + 1
+                                                           : 2 * i + 2;
+        }
+        leaves[t] = lv + (t * m.leaves_per_tree + (i - m.splits_per_tree)) * n;
+      }
+    } else {
+      const auto& forest = m.forests[iter];
+      leaves.resize(forest.size());
+      for (size_t i = 0; i < forest.size(); ++i) {
+        unsigned long leaf = 0;
+        leaves[i] = &forest[i](features, leaf)(0);
+      }
     }
     auto prefetch = [&](size_t i) {
       for (long k = 0; k < n; k += static_cast<long>(line_floats)) {
@@ -361,7 +458,8 @@ Status LandmarkPredictor::Predict(const cv::Mat& gray, const cv::Rect2d& box,
       for (long k = 0; k < n; ++k) s[k] += v[k];
     }
   }
-  const dlib::point_transform_affine to_img = dlib::impl::unnormalizing_tform(r);
+  const dlib::point_transform_affine to_img =
+      dlib::impl::unnormalizing_tform(r);
   landmarks->resize(m.num_parts());
   for (unsigned long i = 0; i < m.num_parts(); ++i) {
     const dlib::dpoint p = to_img(dlib::impl::location(shape, i));
@@ -373,7 +471,8 @@ Status LandmarkPredictor::Predict(const cv::Mat& gray, const cv::Rect2d& box,
 std::vector<Eigen::Vector2d> LandmarkPredictor::MeanShape() const {
   std::vector<Eigen::Vector2d> out(impl_->num_parts());
   for (unsigned long i = 0; i < impl_->num_parts(); ++i) {
-    const dlib::vector<float, 2> p = dlib::impl::location(impl_->initial_shape, i);
+    const dlib::vector<float, 2> p =
+        dlib::impl::location(impl_->initial_shape, i);
     out[i] = Eigen::Vector2d(p.x(), p.y());
   }
   return out;
