@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <random>
 #include <string>
@@ -252,6 +253,8 @@ TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
   TempDir dir;
   const std::string good = dir.File("good.bag");
   WriteBag(good, rosbag::compression::LZ4, 8000, false, /*noisy_images=*/true);
+  WriteBag(dir.File("small.bag"), rosbag::compression::Uncompressed, 768 * 1024,
+           false);
   const std::vector<char> bytes = Slurp(good);
   ASSERT_GT(bytes.size(), 200000u);
   // Cut anywhere: either refused at Open (the index is at the end) or, if
@@ -264,6 +267,30 @@ TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
     std::string why;
     EXPECT_FALSE(reader.Open(path, &why)) << "cut at " << cut;
     EXPECT_FALSE(why.empty());
+  }
+  // An index time out of ros::Time's range (it throws on construction):
+  // refused, not thrown. Index entries are the (sec, nsec) pairs of the
+  // first stamp not behind a "name=" (message and chunk headers have one).
+  {
+    std::vector<char> bad = Slurp(dir.File("small.bag"));
+    const uint32_t sec = 1700000000, nsec = 0;
+    char pattern[8];
+    std::memcpy(pattern, &sec, 4);
+    std::memcpy(pattern + 4, &nsec, 4);
+    size_t hits = 0;
+    for (size_t i = 1; i + 8 <= bad.size(); ++i) {
+      if (bad[i - 1] != '=' && std::memcmp(&bad[i], pattern, 8) == 0) {
+        std::memset(&bad[i], 0xff, 8);
+        ++hits;
+      }
+    }
+    ASSERT_GT(hits, 0u);
+    const std::string path = dir.File("bad_time.bag");
+    Spill(path, bad);
+    IndexedBagReader reader;
+    std::string why;
+    EXPECT_FALSE(reader.Open(path, &why));
+    EXPECT_NE(why.find("bad index"), std::string::npos) << why;
   }
   // Noise over the first half of the file, which is mostly LZ4 chunk data
   // (pseudo-random images do not compress): every Next either gives a

@@ -169,11 +169,19 @@ bool IndexedBagReader::Open(const std::string& path, std::string* why) {
   file_size_ = static_cast<uint64_t>(st.st_size);
   // Read in order, mostly: let the kernel read ahead.
   madvise(m, file_size_, MADV_SEQUENTIAL);
-  if (!ReadIndex(why)) {
-    Unmap();
-    return false;
+  bool ok = false;
+  try {
+    ok = ReadIndex(why);
+  } catch (const std::exception& e) {  // ros::Time out of range, no memory
+    *why = std::string("bad index: ") + e.what();
   }
-  return true;
+  if (!ok) {
+    Unmap();
+    connections_.clear();
+    indexes_.clear();
+    chunks_.clear();
+  }
+  return ok;
 }
 
 bool IndexedBagReader::ReadIndex(std::string* why) {
