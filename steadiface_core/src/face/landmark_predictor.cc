@@ -44,14 +44,17 @@ struct LandmarkPredictor::Impl {
     uint32_t idx1, idx2;
     float thresh;
   };
-  std::vector<Split>
-      splits;  // cascade c, tree t: from (c * trees + t) * splits_per_tree
-  float* leaves =
-      nullptr;  // ... leaf l: ((c * trees + t) * leaves_per_tree + l) * n
+  // Cascade c, tree t: its splits from (c * trees + t) * splits_per_tree,
+  // its leaf l at ((c * trees + t) * leaves_per_tree + l) * n floats.
+  std::vector<Split> splits;
+  float* leaves = nullptr;
   size_t leaves_bytes = 0;
   size_t trees = 0, splits_per_tree = 0, leaves_per_tree = 0;
   bool packed() const { return leaves != nullptr; }
   void Pack();
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
   ~Impl() { std::free(leaves); }
 };
 
