@@ -49,7 +49,6 @@ struct LandmarkPredictor::Impl {
   // its leaf l at ((c * trees + t) * leaves_per_tree + l) * n floats.
   std::vector<Split> splits;
   float* leaves = nullptr;
-  size_t leaves_bytes = 0;
   size_t trees = 0, splits_per_tree = 0, leaves_per_tree = 0;
   bool packed() const { return leaves != nullptr; }
   void Pack();
@@ -83,7 +82,8 @@ void LandmarkPredictor::Impl::Pack() {
   }
   constexpr size_t kLine = 64;
   const size_t floats = forests.size() * trees * leaves_per_tree * n;
-  leaves_bytes = (floats * sizeof(float) + kLine - 1) / kLine * kLine;
+  const size_t leaves_bytes =
+      (floats * sizeof(float) + kLine - 1) / kLine * kLine;
   leaves = static_cast<float*>(std::aligned_alloc(kLine, leaves_bytes));
   if (leaves == nullptr) return;
   splits.reserve(forests.size() * trees * splits_per_tree);

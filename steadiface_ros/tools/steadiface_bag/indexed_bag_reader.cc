@@ -251,7 +251,6 @@ bool IndexedBagReader::ReadIndex(std::string* why) {
   // multiset per connection, filled in chunk order as rosbag does.
   for (const auto& ci : chunk_infos) {
     Chunk chunk;
-    chunk.pos = ci.first;
     if (!ParseRecord(file_, file_size_, ci.first, &r) || !r.Op(&op) ||
         op != kOpChunk || !r.String("compression", &chunk.compression) ||
         !r.Uint32("size", &chunk.size)) {
@@ -293,7 +292,7 @@ bool IndexedBagReader::ReadIndex(std::string* why) {
       }
       q += r.total_size;
     }
-    chunks_[chunk.pos] = chunk;
+    chunks_[ci.first] = chunk;
   }
   return true;
 }

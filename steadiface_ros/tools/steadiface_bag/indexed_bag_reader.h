@@ -89,7 +89,6 @@ class IndexedBagReader {
     const Range* range = nullptr;
   };
   struct Chunk {
-    uint64_t pos = 0;
     std::string compression;
     uint32_t size = 0;              // uncompressed
     const uint8_t* data = nullptr;  // in the file
