@@ -377,10 +377,13 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
                                 ? sensor_msgs::image_encodings::MONO8
                                 : frame.output.channels() == 4 ? sensor_msgs::image_encodings::BGRA8
                                                                : sensor_msgs::image_encodings::BGR8;
-    sensor_msgs::ImagePtr img = cv_bridge::CvImage(out_header, enc, frame.output).toImageMsg();
     sensor_msgs::CameraInfoPtr info(
         new sensor_msgs::CameraInfo(ToCameraInfo(frame.output_intrinsics, out_header)));
-    sink_->PublishImage(img, info);
+    if (sink_->WantsImage()) {
+      sink_->PublishImage(cv_bridge::CvImage(out_header, enc, frame.output).toImageMsg(), info);
+    } else {
+      sink_->PublishOutputInfo(info);
+    }
   }
   const ros::Time published = sink_->Now();
   if (!passthrough) {

@@ -152,6 +152,40 @@ TEST(WrapperTest, CleanStreamIsStabilizedFrameByFrame) {
   for (size_t i = 1; i < stamps.size(); ++i) EXPECT_GT(stamps[i], stamps[i - 1]);
 }
 
+// A sink that does not consume the stabilized pixels (the bag tool with
+// only a report) gets each frame's output camera_info through
+// PublishOutputInfo, and no image; everything else is what a sink that
+// takes the images gets.
+TEST(WrapperTest, SinkWithoutImagesGetsTheSameInfosAndStates) {
+  struct InfoOnlySink : public Sink {
+    bool WantsImage() const override { return false; }
+    void PublishOutputInfo(const sensor_msgs::CameraInfoPtr& c) override { infos.push_back(c); }
+  };
+  for (bool pipelined : {false, true}) {
+    Sink a;
+    InfoOnlySink b;
+    WrapperOptions wo;
+    wo.pipelined = pipelined;
+    StabilizerWrapper wa(Options(), wo, &a), wb(Options(), wo, &b);
+    Feed(&wa, TestStream());
+    Feed(&wb, TestStream());
+    ASSERT_EQ(a.images.size(), TestStream().images.size());
+    EXPECT_TRUE(b.images.empty());
+    ASSERT_EQ(b.infos.size(), a.infos.size());
+    ASSERT_EQ(b.states.size(), a.states.size());
+    for (size_t i = 0; i < a.infos.size(); ++i) {
+      EXPECT_EQ(b.infos[i]->header.stamp, a.infos[i]->header.stamp);
+      EXPECT_EQ(b.infos[i]->header.frame_id, a.infos[i]->header.frame_id);
+      EXPECT_EQ(b.infos[i]->width, a.infos[i]->width);
+      EXPECT_EQ(b.infos[i]->height, a.infos[i]->height);
+      EXPECT_TRUE(b.infos[i]->K == a.infos[i]->K) << "frame " << i;
+      EXPECT_EQ(b.states[i].virtual_rotation.w, a.states[i].virtual_rotation.w);
+      EXPECT_EQ(b.states[i].principal_offset[0], a.states[i].principal_offset[0]);
+    }
+    ASSERT_EQ(b.tf.size(), a.tf.size());
+  }
+}
+
 // pipelined (frame n renders on a second thread while frame n+1 is
 // processed): the same images, states and TF, in the same order, as the
 // one-stage wrapper; each frame is published by the next one or by the

@@ -31,6 +31,13 @@ class OutputSink {
   virtual ~OutputSink() = default;
   virtual void PublishImage(const sensor_msgs::ImagePtr& image,
                             const sensor_msgs::CameraInfoPtr& info) = 0;
+  /// Whether the stabilized image's pixels are consumed. When false the
+  /// frame is still rendered, but its pixels are not copied into a message:
+  /// the wrapper calls PublishOutputInfo instead of PublishImage (the bag
+  /// tool with only a report to write). Asked once per frame.
+  virtual bool WantsImage() const { return true; }
+  /// The stabilized camera_info of a frame whose image is not wanted.
+  virtual void PublishOutputInfo(const sensor_msgs::CameraInfoPtr& /*info*/) {}
   virtual void PublishLandmarks(const steadiface::FaceLandmarks& msg) = 0;
   virtual void PublishState(const steadiface::StabilizerState& msg) = 0;
   virtual void PublishTf(const std::vector<geometry_msgs::TransformStamped>& tf) = 0;

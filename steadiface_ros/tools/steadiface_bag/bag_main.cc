@@ -243,6 +243,7 @@ int main(int argc, char** argv) {
     sink.out = writer.get();
   }
   steadiface_bag::SideBySideVideo video(a.video);
+  sink.wants_image = !a.out.empty() || video.enabled();
 
   // Stabilizer stage.
   steadiface_bag::FrameSelection selection;

@@ -45,6 +45,10 @@ void BagSink::PublishImage(const sensor_msgs::ImagePtr& image,
   }
 }
 
+void BagSink::PublishOutputInfo(const sensor_msgs::CameraInfoPtr& info) {
+  last_info = *info;
+}
+
 void BagSink::PublishLandmarks(const steadiface::FaceLandmarks& m) {
   landmarks.push_back(m);
   if (out) out->WriteCopy(T("face_landmarks"), m.header.stamp, m);

@@ -70,6 +70,11 @@ class BagSink : public steadiface_ros::OutputSink {
   void PublishTf(
       const std::vector<geometry_msgs::TransformStamped>& tf) override;
   bool WantsDebugImage() const override { return debug; }
+  /// The stabilized pixels are needed (an output bag or the side-by-side
+  /// video); with only a report, just the output camera_info is kept.
+  bool wants_image = true;
+  bool WantsImage() const override { return wants_image; }
+  void PublishOutputInfo(const sensor_msgs::CameraInfoPtr& info) override;
   void PublishDebugImage(const sensor_msgs::ImagePtr& image) override;
   void Warn(const std::string& key, const std::string& text) override;
   void Error(const std::string& key, const std::string& text) override;
