@@ -52,6 +52,9 @@ class BagSink : public steadiface_ros::OutputSink {
   /// Also write the rendered debug images into the output bag (they are raw
   /// images: about as large as the stabilized stream itself).
   bool debug_to_bag = false;
+  /// The stabilized pixels are needed (an output bag or the side-by-side
+  /// video); with only a report, just the output camera_info is kept.
+  bool wants_image = true;
   /// Same names as the node publishes in the camera's namespace.
   std::string ns = "/camera";
   std::string T(const std::string& leaf) const { return ns + "/" + leaf; }
@@ -70,9 +73,6 @@ class BagSink : public steadiface_ros::OutputSink {
   void PublishTf(
       const std::vector<geometry_msgs::TransformStamped>& tf) override;
   bool WantsDebugImage() const override { return debug; }
-  /// The stabilized pixels are needed (an output bag or the side-by-side
-  /// video); with only a report, just the output camera_info is kept.
-  bool wants_image = true;
   bool WantsImage() const override { return wants_image; }
   void PublishOutputInfo(const sensor_msgs::CameraInfoPtr& info) override;
   void PublishDebugImage(const sensor_msgs::ImagePtr& image) override;
