@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/mesh_sampler.h"
 #include "steadiface_core/so3.h"
 #include "steadiface_core/warper.h"
 
@@ -78,6 +79,26 @@ void BM_DirectSample(benchmark::State& state) {
   for (auto _ : state) f.warper->Render(f.input, &f.output);
 }
 
+// The same mesh through the portable kernel only (SampleKernel::kPortable):
+// for bgr8 the A/B of the shuffle kernel in one binary; mono8 is the same
+// kernel either way. Reports the share of pixels the shuffle kernel took in
+// the default path as the counter "shuffle_share".
+void BM_DirectSamplePortable(benchmark::State& state) {
+  Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  const cv::Size out(f.warper->output_geometry().width(),
+                     f.warper->output_geometry().height());
+  SampleStats st;
+  SampleMesh(f.warper->mesh(), f.input, out.width, out.height, &f.output,
+             SampleKernel::kAuto, &st);
+  for (auto _ : state) {
+    SampleMesh(f.warper->mesh(), f.input, out.width, out.height, &f.output,
+               SampleKernel::kPortable);
+  }
+  state.counters["shuffle_share"] =
+      static_cast<double>(st.shuffle_px) / static_cast<double>(out.area());
+}
+
 // Mesh + direct sampling (the default).
 void BM_WarpEndToEnd(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
@@ -101,6 +122,7 @@ BENCHMARK(BM_Mesh)->Apply(Args);
 BENCHMARK(BM_Maps)->Apply(Args);
 BENCHMARK(BM_Remap)->Apply(Args);
 BENCHMARK(BM_DirectSample)->Apply(Args);
+BENCHMARK(BM_DirectSamplePortable)->Apply(Args);
 BENCHMARK(BM_WarpEndToEnd)->Apply(Args);
 BENCHMARK(BM_BareRemapFloor)->Apply(Args);
 

@@ -1,10 +1,16 @@
 #include "steadiface_core/mesh_sampler.h"
 
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <vector>
 
 #include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/core/utility.hpp>
+#if CV_SIMD128 && defined(__GNUC__) && \
+    (defined(__x86_64__) || defined(__i386__))
+#include <tmmintrin.h>
+#endif
 
 #include "steadiface_core/mesh_scanline.h"
 #include "steadiface_core/warper.h"
@@ -196,12 +202,263 @@ inline void Color4(const uchar* base, size_t step, const cv::v_int32x4& X,
 }
 #endif  // CV_SIMD128
 
-// One output row.
+// The two byte operations the shuffle kernel needs, which OpenCV's
+// universal intrinsics do not offer outside OpenCV's own build:
+// ShuffleBytes: r[i] = a[idx[i]] for idx[i] < 16, 0 for idx[i] >= 0x80;
+// MulAddPairs: 16-bit r[i] = a[2i] w[2i] + a[2i+1] w[2i+1], bytes unsigned,
+// w[] <= 127 (here <= 32, so no sum saturates).
+// SSSE3's pshufb and pmaddubsw on x86 (chosen at run time: the functions
+// carrying them are compiled for SSSE3, the rest of the file for the
+// baseline); tbl and umull + addp on AArch64. Elsewhere the portable kernel
+// runs.
+#if CV_SIMD128 && defined(__GNUC__) && \
+    (defined(__x86_64__) || defined(__i386__))
+#define STEADIFACE_SHUFFLE_KERNEL 1
+#define STEADIFACE_SHUFFLE_TARGET __attribute__((target("ssse3")))
+STEADIFACE_SHUFFLE_TARGET inline cv::v_uint8x16 ShuffleBytes(
+    const cv::v_uint8x16& a, const cv::v_uint8x16& idx) {
+  return cv::v_uint8x16(_mm_shuffle_epi8(a.val, idx.val));
+}
+STEADIFACE_SHUFFLE_TARGET inline cv::v_int16x8 MulAddPairs(
+    const cv::v_uint8x16& a, const cv::v_uint8x16& w) {
+  return cv::v_int16x8(_mm_maddubs_epi16(a.val, w.val));
+}
+bool ShuffleSupported() { return cv::checkHardwareSupport(CV_CPU_SSSE3); }
+#elif CV_SIMD128 && CV_NEON && defined(__aarch64__)
+#define STEADIFACE_SHUFFLE_KERNEL 1
+#define STEADIFACE_SHUFFLE_TARGET
+inline cv::v_uint8x16 ShuffleBytes(const cv::v_uint8x16& a,
+                                   const cv::v_uint8x16& idx) {
+  return cv::v_uint8x16(vqtbl1q_u8(a.val, idx.val));
+}
+inline cv::v_int16x8 MulAddPairs(const cv::v_uint8x16& a,
+                                 const cv::v_uint8x16& w) {
+  const uint16x8_t lo = vmull_u8(vget_low_u8(a.val), vget_low_u8(w.val));
+  const uint16x8_t hi = vmull_high_u8(a.val, w.val);
+  return cv::v_int16x8(vreinterpretq_s16_u16(vpaddq_u16(lo, hi)));
+}
+bool ShuffleSupported() { return true; }
+#else
+bool ShuffleSupported() { return false; }
+#endif
+
+#ifdef STEADIFACE_SHUFFLE_KERNEL
+// The shuffle kernel, 3 channels, 4 output pixels per step. When the 4
+// pixels read one source row pair (same iy) and at most 4 adjacent source
+// columns (ix0..ix0+3 and their right neighbours: 15 bytes), one 16-byte
+// load per row holds every byte they need, and byte shuffles pick them out;
+// no per-pixel address, no scalar loads. The group's 12 (pixel, channel)
+// samples P = 3 pixel + channel each take a (left, right) byte pair; pairs
+// 0-7 fill register A, 8-11 the low half of register B.
+//   Horizontal step first: per pair left (32 - fx) + right fx, a byte-pair
+//   dot product, <= 255 * 32 (exact in 16 bits).
+//   Vertical step: the rows' sums zipped (top, bottom) and dotted with
+//   64 ((32 - fy), fy), exact in 32 bits (<= 255 * 1024 * 64 < 2^24).
+// The same integer sum h as cv::remap's (and the portable kernel's), times
+// 64: (64 h + 2^15) >> 16 = (h + 512) >> 10, cv::remap's rounding, is byte 2
+// of each 32-bit lane, which a shuffle picks out (no shifts, no packs). The
+// three zipped registers hold P = 0-3, 4-7, 8-11: the output's bytes in
+// order, bit for bit cv::remap's.
+struct Color3ShuffleTables {
+  /// Registers A, B: the byte of each pair's pixel's 32-bit lane (its low
+  /// byte) for both bytes of the pair; 0x80 (zero) past pair 11.
+  alignas(16) uint8_t pair_pixel_byte[2][16];
+  /// Registers A, B: each byte's offset from its pixel's left column:
+  /// channel (left byte), 3 + channel (right byte); 0x80 past pair 11.
+  alignas(16) uint8_t pair_offset[2][16];
+  /// Registers A, B: the two bytes of each pair's pixel's horizontal
+  /// weights ((32 - fx), fx) in its 32-bit lane; 0x80 past pair 11.
+  alignas(16) uint8_t pair_weight_byte[2][16];
+  /// Zipped registers 0-2: each 32-bit lane (pair P = 4r + i) takes its
+  /// pixel's 32-bit lane (the vertical weights).
+  alignas(16) uint8_t pixel_word[3][16];
+  /// Sums 0-2: output byte P = 4r + i is byte 2 of lane i of sum r; 0x80
+  /// (zero) elsewhere, so the three OR into the output.
+  alignas(16) uint8_t output_byte[3][16];
+};
+
+constexpr Color3ShuffleTables MakeColor3ShuffleTables() {
+  Color3ShuffleTables t{};
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < 8; ++k) {
+      const int pair = 8 * r + k, pixel = pair / 3, channel = pair % 3;
+      const bool used = pair < 12;
+      for (int right = 0; right < 2; ++right) {
+        t.pair_pixel_byte[r][2 * k + right] =
+            used ? static_cast<uint8_t>(4 * pixel) : 0x80;
+        t.pair_offset[r][2 * k + right] =
+            used ? static_cast<uint8_t>(3 * right + channel) : 0x80;
+        t.pair_weight_byte[r][2 * k + right] =
+            used ? static_cast<uint8_t>(4 * pixel + right) : 0x80;
+      }
+    }
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int i = 0; i < 4; ++i) {
+      const int pixel = (4 * r + i) / 3;
+      for (int b = 0; b < 4; ++b) {
+        t.pixel_word[r][4 * i + b] = static_cast<uint8_t>(4 * pixel + b);
+      }
+    }
+    for (int b = 0; b < 16; ++b) {
+      t.output_byte[r][b] =
+          b / 4 == r ? static_cast<uint8_t>(4 * (b % 4) + 2) : 0x80;
+    }
+  }
+  return t;
+}
+constexpr Color3ShuffleTables kColor3Shuffle = MakeColor3ShuffleTables();
+
+// A stepped 3-channel segment: shuffle groups where they apply, the
+// portable 4-pixel group or scalar pixels elsewhere (same arithmetic).
+STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
+                                                    const cv::Mat& in,
+                                                    int width, uchar* out,
+                                                    SampleStats* counts) {
+  using namespace cv;
+  constexpr int shift = kScanFrac + kInterBits;
+  const uchar* base = in.ptr<uchar>(0);
+  const size_t step = in.step[0];
+  const int n = seg.u1 - seg.u0 + 1;
+  if (n < 4) {
+    int32_t X = seg.X, Y = seg.Y;
+    for (int u = seg.u0; u <= seg.u1; ++u, X += seg.DX, Y += seg.DY) {
+      SamplePixel(in, 3, X >> kScanFrac, Y >> kScanFrac, out + u * 3);
+    }
+    counts->scalar_px += n;
+    return;
+  }
+  // Locals, not seg's fields: the output stores (uchar) may alias seg, so
+  // the compiler would reload them after each one.
+  const int32_t X0 = seg.X, Y0 = seg.Y, DX = seg.DX, DY = seg.DY;
+  const int u0 = seg.u0;
+  const int max_iy = in.rows - 2;
+  // A 16-byte load at pixel ix0 stays in its row for ix0 <= cols - 6.
+  const int max_ix_shuffle = in.cols - 6;
+  const int max_ix_portable = in.cols - 3;
+  // The whole segment within the shuffle's margins and 0 <= DX <= 1 px (so
+  // 4 pixels span at most ix0..ix0+3): only the source row can still differ
+  // within a group, and only that is checked per group.
+  const bool whole = DX >= 0 && DX <= (1 << shift) &&
+                     GroupInside(X0, Y0, DX, DY, n, max_ix_shuffle, max_iy);
+  const v_int32x4 ramp(0, DX, 2 * DX, 3 * DX);
+  const v_int32x4 rampy(0, DY, 2 * DY, 3 * DY);
+  const v_int32x4 dx4 = v_setall_s32(4 * DX), dy4 = v_setall_s32(4 * DY);
+  const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
+  // fy, 64 times, from Y in one shift: Y >> (kScanFrac - 6), masked.
+  const v_int32x4 m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
+  const v_int32x4 k32 = v_setall_s32(kInterTabSize);
+  const v_int32x4 k32x64 = v_setall_s32(kInterTabSize << 6);
+  const v_uint16x8 k255 = v_setall_u16(255);
+  const v_int32x4 half = v_setall_s32(1 << 15);
+  const v_uint8x16 pix_a = v_load(kColor3Shuffle.pair_pixel_byte[0]);
+  const v_uint8x16 pix_b = v_load(kColor3Shuffle.pair_pixel_byte[1]);
+  const v_uint8x16 off_a = v_load(kColor3Shuffle.pair_offset[0]);
+  const v_uint8x16 off_b = v_load(kColor3Shuffle.pair_offset[1]);
+  const v_uint8x16 wsel_a = v_load(kColor3Shuffle.pair_weight_byte[0]);
+  const v_uint8x16 wsel_b = v_load(kColor3Shuffle.pair_weight_byte[1]);
+  const v_uint8x16 word0 = v_load(kColor3Shuffle.pixel_word[0]);
+  const v_uint8x16 word1 = v_load(kColor3Shuffle.pixel_word[1]);
+  const v_uint8x16 word2 = v_load(kColor3Shuffle.pixel_word[2]);
+  const v_uint8x16 out0 = v_load(kColor3Shuffle.output_byte[0]);
+  const v_uint8x16 out1 = v_load(kColor3Shuffle.output_byte[1]);
+  const v_uint8x16 out2 = v_load(kColor3Shuffle.output_byte[2]);
+  int64_t shuffled = 0, portable = 0, scalar = 0;
+  int32_t X = X0, Y = Y0;
+  // The group's 4 coordinates, stepped like X and Y.
+  v_int32x4 Xv = v_setall_s32(X0) + ramp, Yv = v_setall_s32(Y0) + rampy;
+  for (int g = 0; g < n;
+       g += 4, X += 4 * DX, Y += 4 * DY, Xv += dx4, Yv += dy4) {
+    if (g + 4 > n) {  // overlapping last group, as in SampleRow
+      g = n - 4;
+      X = X0 + g * DX;
+      Y = Y0 + g * DY;
+      Xv = v_setall_s32(X) + ramp;
+      Yv = v_setall_s32(Y) + rampy;
+    }
+    const int u = u0 + g;
+    const int ix0 = X >> shift, iy0 = Y >> shift;
+    const int iy3 = (Y + 3 * DY) >> shift;
+    uchar* dst = out + u * 3;
+    if (iy0 != iy3 ||
+        (!whole &&
+         (static_cast<unsigned>(((X + 3 * DX) >> shift) - ix0) > 3u ||
+          ix0 < 0 || ix0 > max_ix_shuffle || iy0 < 0 || iy0 > max_iy))) {
+      if (GroupInside(X, Y, DX, DY, 4, max_ix_portable, max_iy)) {
+        Color4<3>(base, step, Xv, Yv, u + 6 <= width, dst);
+        portable += 4;
+      } else {
+        for (int k = 0; k < 4; ++k) {
+          SamplePixel(in, 3, (X + k * DX) >> kScanFrac,
+                      (Y + k * DY) >> kScanFrac, dst + 3 * k);
+        }
+        scalar += 4;
+      }
+      continue;
+    }
+    const uchar* p = base + static_cast<size_t>(iy0) * step + ix0 * 3;
+    const v_uint8x16 top = v_load(p);
+    const v_uint8x16 bottom = v_load(p + step);
+    // Each pixel's byte offset from pixel ix0 (0..9), and its weights, one
+    // 32-bit lane per pixel (adds and 16-bit multiplies rather than shifts:
+    // shifts share the shuffles' ports).
+    const v_int32x4 rel = v_shr<shift>(Xv) - v_setall_s32(ix0);
+    const v_uint8x16 off = v_reinterpret_as_u8(rel + rel + rel);
+    const v_int32x4 fx = v_shr<kScanFrac>(Xv) & m31;
+    // Bytes (32 - fx, fx): 32 + 255 fx (fx < 32: the high 16 bits stay 0).
+    const v_uint8x16 wx = v_reinterpret_as_u8(
+        k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fx), k255)));
+    const v_int32x4 fy64 = v_shr<kScanFrac - 6>(Yv) & m31x64;
+    // 16-bit halves (64 (32 - fy), 64 fy).
+    const v_uint8x16 wy =
+        v_reinterpret_as_u8((k32x64 - fy64) | v_shl<16>(fy64));
+    // Horizontal step, per row and pair.
+    const v_uint8x16 idx_a = ShuffleBytes(off, pix_a) + off_a;
+    const v_uint8x16 idx_b = ShuffleBytes(off, pix_b) + off_b;
+    const v_uint8x16 w_a = ShuffleBytes(wx, wsel_a);
+    const v_uint8x16 w_b = ShuffleBytes(wx, wsel_b);
+    const v_int16x8 top_a = MulAddPairs(ShuffleBytes(top, idx_a), w_a);
+    const v_int16x8 top_b = MulAddPairs(ShuffleBytes(top, idx_b), w_b);
+    const v_int16x8 bot_a = MulAddPairs(ShuffleBytes(bottom, idx_a), w_a);
+    const v_int16x8 bot_b = MulAddPairs(ShuffleBytes(bottom, idx_b), w_b);
+    // Vertical step: (top, bottom) per pair, P = 0-3, 4-7, 8-11; rounded,
+    // and the result byte picked out.
+    v_int16x8 z0, z1, z2, unused;
+    v_zip(top_a, bot_a, z0, z1);
+    v_zip(top_b, bot_b, z2, unused);
+    const v_int32x4 h0 =
+        v_dotprod(z0, v_reinterpret_as_s16(ShuffleBytes(wy, word0))) + half;
+    const v_int32x4 h1 =
+        v_dotprod(z1, v_reinterpret_as_s16(ShuffleBytes(wy, word1))) + half;
+    const v_int32x4 h2 =
+        v_dotprod(z2, v_reinterpret_as_s16(ShuffleBytes(wy, word2))) + half;
+    const v_uint8x16 r = ShuffleBytes(v_reinterpret_as_u8(h0), out0) |
+                         ShuffleBytes(v_reinterpret_as_u8(h1), out1) |
+                         ShuffleBytes(v_reinterpret_as_u8(h2), out2);
+    if (u + 6 <= width) {
+      v_store(dst, r);  // bytes 12-15 (zero): the next pixels', written later
+    } else {
+      v_store_low(dst, r);
+      const unsigned tail = v_extract_n<2>(v_reinterpret_as_u32(r));
+      std::memcpy(dst + 8, &tail, 4);
+    }
+    shuffled += 4;
+  }
+  counts->shuffle_px += shuffled;
+  counts->portable_simd_px += portable;
+  counts->scalar_px += scalar;
+}
+#endif  // STEADIFACE_SHUFFLE_KERNEL
+
+// One output row. `shuffle`: 3-channel stepped segments go through the
+// shuffle kernel (only where ShuffleSupported()).
 void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
-               std::vector<Eigen::Vector2f>* line, uchar* out) {
+               bool shuffle, std::vector<Eigen::Vector2f>* line, uchar* out,
+               SampleStats* counts) {
   const int cn = in.channels();
   const uchar* base = in.ptr<uchar>(0);
   const size_t step = in.step[0];
+  (void)shuffle;
   ForEachScanSegment(m, width, v, line, [&](const ScanSegment& seg) {
     int u = seg.u0;
     if (!seg.stepped) {
@@ -210,8 +467,15 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
         ClampedScanCoordinates(seg, u, &X, &Y);
         SamplePixel(in, cn, X, Y, out + u * cn);
       }
+      counts->scalar_px += seg.u1 - seg.u0 + 1;
       return;
     }
+#ifdef STEADIFACE_SHUFFLE_KERNEL
+    if (shuffle && cn == 3) {
+      Color3SegmentShuffle(seg, in, width, out, counts);
+      return;
+    }
+#endif
     int32_t X = seg.X, Y = seg.Y;
 #if CV_SIMD128
     const int max_iy = in.rows - 2;
@@ -237,11 +501,13 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
             SamplePixel(in, 1, (X + k * seg.DX) >> kScanFrac,
                         (Y + k * seg.DY) >> kScanFrac, out + u + k);
           }
+          counts->scalar_px += 8;
           continue;
         }
         const cv::v_int32x4 Xa = cv::v_setall_s32(X) + ramp;
         const cv::v_int32x4 Ya = cv::v_setall_s32(Y) + rampy;
         Mono8(base, step, Xa, Xa + dx4, Ya, Ya + dy4, out + u);
+        counts->portable_simd_px += 8;
       }
       if (n >= 8) return;
     } else if (cn == 3 || cn == 4) {
@@ -263,8 +529,10 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
             SamplePixel(in, cn, (X + k * seg.DX) >> kScanFrac,
                         (Y + k * seg.DY) >> kScanFrac, out + (u + k) * cn);
           }
+          counts->scalar_px += 4;
           continue;
         }
+        counts->portable_simd_px += 4;
         const cv::v_int32x4 Xv = cv::v_setall_s32(X) + ramp;
         const cv::v_int32x4 Yv = cv::v_setall_s32(Y) + rampy;
         if (cn == 3) {
@@ -276,6 +544,7 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
       if (n >= 4) return;
     }
 #endif  // CV_SIMD128
+    counts->scalar_px += seg.u1 - u + 1;
     for (; u <= seg.u1; ++u, X += seg.DX, Y += seg.DY) {
       SamplePixel(in, cn, X >> kScanFrac, Y >> kScanFrac, out + u * cn);
     }
@@ -284,16 +553,36 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
 
 }  // namespace
 
+bool ShuffleKernelAvailable() {
+  // Asked once: the answer does not change while the process runs.
+  static const bool available = ShuffleSupported();
+  return available;
+}
+
 void SampleMesh(const WarpMesh& mesh, const cv::Mat& input, int width,
-                int height, cv::Mat* output) {
+                int height, cv::Mat* output, SampleKernel kernel,
+                SampleStats* stats) {
   output->create(height, width, input.type());
   cv::Mat& out = *output;
+  const bool shuffle =
+      kernel == SampleKernel::kAuto && ShuffleKernelAvailable();
+  std::atomic<int64_t> shuffle_px{0}, simd_px{0}, scalar_px{0};
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
     std::vector<Eigen::Vector2f> line;
+    SampleStats counts;
     for (int v = range.start; v < range.end; ++v) {
-      SampleRow(mesh, input, width, v, &line, out.ptr<uchar>(v));
+      SampleRow(mesh, input, width, v, shuffle, &line, out.ptr<uchar>(v),
+                &counts);
     }
+    shuffle_px += counts.shuffle_px;
+    simd_px += counts.portable_simd_px;
+    scalar_px += counts.scalar_px;
   });
+  if (stats != nullptr) {
+    stats->shuffle_px = shuffle_px;
+    stats->portable_simd_px = simd_px;
+    stats->scalar_px = scalar_px;
+  }
 }
 
 }  // namespace steadiface

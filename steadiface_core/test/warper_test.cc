@@ -1,6 +1,7 @@
 #include "steadiface_core/warper.h"
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -8,6 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "steadiface_core/debug_overlay.h"
+#include "steadiface_core/mesh_sampler.h"
+#include "steadiface_core/mesh_scanline.h"
 #include "steadiface_core/sim/background.h"
 #include "steadiface_core/so3.h"
 #include "test_util.h"
@@ -471,6 +474,116 @@ TEST(WarperTest, DirectSamplingIsRemapBitForBit) {
     }
   }
   EXPECT_GE(border_frames, 2);  // the large pose shows the black border
+}
+
+// The scan set-up's inline rounding is std::lround's, on every float of
+// a sweep of bit patterns (all exponents, both signs), the halves around
+// each integer up to 2^24, and the neighbours of 0.5.
+TEST(WarperTest, RoundHalfAwayFromZeroIsLround) {
+  int checked = 0;
+  for (uint32_t bits = 0; bits < 0xFF000000u; bits += 9973u) {
+    float x;
+    std::memcpy(&x, &bits, sizeof(x));
+    if (!std::isfinite(x) || std::abs(x) >= 4.0e18f) continue;
+    ASSERT_EQ(RoundHalfAwayFromZero(x), std::lround(x)) << x;
+    ++checked;
+  }
+  for (int i = -(1 << 24); i <= (1 << 24); i += 257) {
+    for (float x : {i + 0.5f, i - 0.5f, std::nextafter(i + 0.5f, 0.0f),
+                    std::nextafter(i + 0.5f, 1e9f), std::nextafter(i - 0.5f, -1e9f)}) {
+      ASSERT_EQ(RoundHalfAwayFromZero(x), std::lround(x)) << x;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(RoundHalfAwayFromZero(std::nextafter(0.5f, 0.0f)), 0);
+  EXPECT_EQ(RoundHalfAwayFromZero(0.5f), 1);
+  EXPECT_EQ(RoundHalfAwayFromZero(-0.5f), -1);
+  EXPECT_GT(checked, 400000);
+}
+
+// A mesh of `cells` x `cells` cells over a w x h output whose vertices
+// sample the input at A (u, v) + b: an affine warp made by hand, so the
+// test reaches flips, zoom-out, steep rotations and every edge.
+WarpMesh AffineMesh(int w, int h, int cells, const Eigen::Matrix2f& A,
+                    const Eigen::Vector2f& b) {
+  WarpMesh m;
+  m.cols = m.rows = cells + 1;
+  for (int i = 0; i <= cells; ++i) {
+    m.u.push_back(-0.5 + (w * static_cast<double>(i)) / cells);
+    m.v.push_back(-0.5 + (h * static_cast<double>(i)) / cells);
+  }
+  for (int j = 0; j <= cells; ++j) {
+    for (int i = 0; i <= cells; ++i) {
+      const Eigen::Vector2f uv(static_cast<float>(m.u[i]), static_cast<float>(m.v[j]));
+      m.source.push_back(A * uv + b);
+      m.source_row.push_back(m.source.back().y());
+    }
+  }
+  return m;
+}
+
+// The shuffle kernel (bgr8: one 16-byte load per source row for 4 output
+// pixels, byte shuffles) against the portable kernel, which
+// DirectSamplingIsRemapBitForBit ties to cv::remap: bit for bit on a real
+// photo, over zooms in and out, rotations up to 30 degrees, a mirror, and
+// offsets that run the groups off every edge of the input. Where it applies
+// (zoom in, small rotation) it must sample most of the frame, or the speed
+// it exists for is not there.
+TEST(WarperTest, ShuffleKernelIsThePortableKernelBitForBit) {
+  if (!ShuffleKernelAvailable()) GTEST_SKIP() << "no byte shuffle on this CPU";
+  cv::Mat photo = LoadImage("leuvenA.jpg");
+  for (const cv::Size size : {cv::Size(640, 480), cv::Size(333, 251), cv::Size(7, 5)}) {
+    cv::Mat bgr;
+    cv::resize(photo, bgr, size, 0, 0, cv::INTER_AREA);
+    int cases = 0;
+    for (double scale : {0.7, 0.85, 1.0, 1.3, 2.5}) {
+      for (double angle_deg : {0.0, 0.7, -3.0, 12.0, 30.0}) {
+        for (bool mirror : {false, true}) {
+          for (const Eigen::Vector2f& shift :
+               {Eigen::Vector2f(0, 0), Eigen::Vector2f(-0.3f * size.width, 0.2f * size.height),
+                Eigen::Vector2f(0.25f * size.width, -0.3f * size.height)}) {
+            const float a = static_cast<float>(angle_deg * M_PI / 180.0);
+            Eigen::Matrix2f A;
+            A << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+            A *= static_cast<float>(scale);
+            if (mirror) A.col(0) *= -1.0f;
+            // Centre to centre, then the shift.
+            const Eigen::Vector2f c_out(0.5f * size.width, 0.5f * size.height);
+            const Eigen::Vector2f b = c_out - A * c_out + shift;
+            const WarpMesh mesh = AffineMesh(size.width, size.height, 8, A, b);
+            cv::Mat fast, portable;
+            SampleStats st;
+            SampleMesh(mesh, bgr, size.width, size.height, &fast, SampleKernel::kAuto, &st);
+            SampleMesh(mesh, bgr, size.width, size.height, &portable, SampleKernel::kPortable);
+            ASSERT_EQ(cv::norm(fast, portable, cv::NORM_INF), 0.0)
+                << size << " scale " << scale << " angle " << angle_deg << " mirror " << mirror
+                << " shift " << shift.transpose();
+            const double px = static_cast<double>(size.area());
+            if (size.width >= 333 && scale <= 0.85 && std::abs(angle_deg) <= 3.0 && !mirror &&
+                shift.isZero()) {
+              // Zoom in, small rotation, no border: the case it is for.
+              EXPECT_GE(st.shuffle_px, 0.85 * px) << size << " scale " << scale << " angle "
+                                                  << angle_deg;
+              ++cases;
+            }
+            if (mirror || scale >= 2.5) EXPECT_EQ(st.shuffle_px, 0);  // never applies
+          }
+        }
+      }
+    }
+    if (size.width >= 333) EXPECT_EQ(cases, 6);
+  }
+  // Other channel counts never take it.
+  cv::Mat grey;
+  cv::cvtColor(photo, grey, cv::COLOR_BGR2GRAY);
+  const WarpMesh mesh =
+      AffineMesh(grey.cols, grey.rows, 8, 0.8f * Eigen::Matrix2f::Identity(),
+                 Eigen::Vector2f(0.1f * grey.cols, 0.1f * grey.rows));
+  cv::Mat out;
+  SampleStats st;
+  SampleMesh(mesh, grey, grey.cols, grey.rows, &out, SampleKernel::kAuto, &st);
+  EXPECT_EQ(st.shuffle_px, 0);
+  EXPECT_GT(st.portable_simd_px, grey.total() / 2);
 }
 
 }  // namespace

@@ -1,10 +1,36 @@
 #pragma once
 
+#include <cstdint>
+
 #include <opencv2/core.hpp>
 
 namespace steadiface {
 
 struct WarpMesh;
+
+/// Which kernel samples 3-channel input.
+enum class SampleKernel {
+  /// The shuffle kernel where the CPU has it (SSSE3 on x86, any AArch64),
+  /// else the portable one. Both give the same output bit for bit.
+  kAuto,
+  /// The portable universal-intrinsics kernel only (tests, benchmarks).
+  kPortable,
+};
+
+/// How many output pixels each path sampled (a segment's overlapping last
+/// group counts in full, so the sum can exceed width x height slightly).
+struct SampleStats {
+  /// 3 channels, a group of 4 from one 16-byte load per source row.
+  int64_t shuffle_px = 0;
+  /// Universal intrinsics, every pixel's neighbourhood loaded on its own.
+  int64_t portable_simd_px = 0;
+  /// One pixel at a time: groups at the input's edge, short segments,
+  /// coordinates outside the stepping range, 2 channels.
+  int64_t scalar_px = 0;
+};
+
+/// True when SampleKernel::kAuto runs the shuffle kernel for 3 channels.
+bool ShuffleKernelAvailable();
 
 /// Renders `output` (width x height, the input's type) by sampling `input`
 /// (8-bit, 1-4 channels) through the warp mesh directly: per output row and
@@ -19,7 +45,15 @@ struct WarpMesh;
 /// cv::remap gives with the same fixed-point maps. Deterministic: the result
 /// does not depend on the thread count. Rows are split over OpenCV's
 /// threads (cv::parallel_for_).
+///
+/// 3-channel input (bgr8) goes through a shuffle kernel where the CPU has
+/// one (`kernel`, ShuffleKernelAvailable()): 4 output pixels that read one
+/// source row pair and at most 4 adjacent columns take one 16-byte load per
+/// row and byte shuffles instead of 8 per-pixel loads; same arithmetic, same
+/// output. `stats`, if given, receives the pixel counts per path.
 void SampleMesh(const WarpMesh& mesh, const cv::Mat& input, int width,
-                int height, cv::Mat* output);
+                int height, cv::Mat* output,
+                SampleKernel kernel = SampleKernel::kAuto,
+                SampleStats* stats = nullptr);
 
 }  // namespace steadiface

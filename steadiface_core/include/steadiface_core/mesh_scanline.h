@@ -20,6 +20,19 @@ constexpr int kScanFrac = 10;
 /// Source coordinates beyond this clamp (they sample the black border).
 constexpr float kScanClamp = 16000.0f;
 
+/// std::lround for a float, inline (libm's lroundf is a call, and the scan
+/// set-up makes four per mesh cell and row): rounds half away from zero.
+/// Exact for every finite float: below 2^62 in magnitude x - trunc(x) is
+/// exact (Sterbenz for |x| >= 1, x itself below, 0 once floats are
+/// integers); larger, infinite or NaN arguments (a one-pixel segment's
+/// unused step can be any value) go to std::lround itself.
+inline int64_t RoundHalfAwayFromZero(float x) {
+  if (!(std::abs(x) < 4.0e18f)) return std::lround(x);
+  const int64_t t = static_cast<int64_t>(x);  // toward zero
+  const float d = x - static_cast<float>(t);
+  return t + (d >= 0.5f ? 1 : 0) - (d <= -0.5f ? 1 : 0);
+}
+
 /// One mesh cell's stretch of one output row: pixels u0..u1 (inclusive),
 /// whose source coordinates are linear in u.
 struct ScanSegment {
@@ -79,12 +92,12 @@ void ForEachScanSegment(const WarpMesh& m, int width, int v,
       const float sc = static_cast<float>(kInterTabSize) *
                        static_cast<float>(1 << kScanFrac);
       s.stepped = true;
-      s.X =
-          static_cast<int32_t>(std::lround(s.x0 * sc)) + (1 << (kScanFrac - 1));
-      s.Y =
-          static_cast<int32_t>(std::lround(s.y0 * sc)) + (1 << (kScanFrac - 1));
-      s.DX = static_cast<int32_t>(std::lround(s.dx * sc));
-      s.DY = static_cast<int32_t>(std::lround(s.dy * sc));
+      s.X = static_cast<int32_t>(RoundHalfAwayFromZero(s.x0 * sc)) +
+            (1 << (kScanFrac - 1));
+      s.Y = static_cast<int32_t>(RoundHalfAwayFromZero(s.y0 * sc)) +
+            (1 << (kScanFrac - 1));
+      s.DX = static_cast<int32_t>(RoundHalfAwayFromZero(s.dx * sc));
+      s.DY = static_cast<int32_t>(RoundHalfAwayFromZero(s.dy * sc));
     }
     f(s);
   }
