@@ -80,9 +80,9 @@ void BM_DirectSample(benchmark::State& state) {
 }
 
 // The same mesh through the portable kernel only (SampleKernel::kPortable):
-// for bgr8 the A/B of the shuffle kernel in one binary; mono8 is the same
-// kernel either way. Reports the share of pixels the shuffle kernel took in
-// the default path as the counter "shuffle_share".
+// the A/B of the shuffle kernels (bgr8, mono8) in one binary. Reports the
+// share of pixels the shuffle kernels took in the default path as the
+// counter "shuffle_share".
 void BM_DirectSamplePortable(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
   f.warper->ComputeMesh(f.R_v, f.t, f.rows);

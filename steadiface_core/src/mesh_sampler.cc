@@ -448,6 +448,133 @@ STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
   counts->portable_simd_px += portable;
   counts->scalar_px += scalar;
 }
+// The shuffle kernel, 1 channel, 8 output pixels per step: when the 8 read
+// one source row pair and at most 15 adjacent columns (ix0..ix0+14 and
+// their right neighbours), one 16-byte load per row holds them all. One
+// shuffle per row makes each pixel's (left, right) byte pair, a byte-pair
+// dot product with ((32 - fx), fx) the horizontal step, and the vertical
+// step, the rounding and the byte pick-out are the 3-channel kernel's (the
+// zipped registers hold pixels 0-3 and 4-7, the lanes of the coordinate
+// vectors, so the vertical weights need no shuffle). Bit for bit cv::remap.
+STEADIFACE_SHUFFLE_TARGET void Mono8SegmentShuffle(const ScanSegment& seg,
+                                                   const cv::Mat& in,
+                                                   uchar* out,
+                                                   SampleStats* counts) {
+  using namespace cv;
+  constexpr int shift = kScanFrac + kInterBits;
+  const uchar* base = in.ptr<uchar>(0);
+  const size_t step = in.step[0];
+  const int n = seg.u1 - seg.u0 + 1;
+  if (n < 8) {
+    int32_t X = seg.X, Y = seg.Y;
+    for (int u = seg.u0; u <= seg.u1; ++u, X += seg.DX, Y += seg.DY) {
+      SamplePixel(in, 1, X >> kScanFrac, Y >> kScanFrac, out + u);
+    }
+    counts->scalar_px += n;
+    return;
+  }
+  // Locals, not seg's fields (the output stores may alias seg).
+  const int32_t X0 = seg.X, Y0 = seg.Y, DX = seg.DX, DY = seg.DY;
+  const int u0 = seg.u0;
+  const int max_iy = in.rows - 2;
+  // A 16-byte load at pixel ix0 stays in its row for ix0 <= cols - 16.
+  const int max_ix_shuffle = in.cols - 16;
+  // The whole segment within the margins and 0 <= 7 DX <= 14 px: only the
+  // source row is checked per group.
+  const bool whole = DX >= 0 && 7 * static_cast<int64_t>(DX) <= (14 << shift) &&
+                     GroupInside(X0, Y0, DX, DY, n, max_ix_shuffle, max_iy);
+  const v_int32x4 ramp(0, DX, 2 * DX, 3 * DX);
+  const v_int32x4 rampy(0, DY, 2 * DY, 3 * DY);
+  const v_int32x4 dx4 = v_setall_s32(4 * DX), dy4 = v_setall_s32(4 * DY);
+  const v_int32x4 dx8 = v_setall_s32(8 * DX), dy8 = v_setall_s32(8 * DY);
+  const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
+  const v_int32x4 m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
+  const v_int32x4 k32 = v_setall_s32(kInterTabSize);
+  const v_int32x4 k32x64 = v_setall_s32(kInterTabSize << 6);
+  const v_uint16x8 k255 = v_setall_u16(255);
+  const v_int32x4 half = v_setall_s32(1 << 15);
+  // Pixel k's offset (16-bit lane k, < 16) to both bytes of pair k, plus
+  // (0, 1): the left and right columns.
+  alignas(16) static constexpr uint8_t kPairLow[16] = {
+      0, 0, 2, 2, 4, 4, 6, 6, 8, 8, 10, 10, 12, 12, 14, 14};
+  alignas(16) static constexpr uint8_t kLeftRight[16] = {
+      0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1};
+  // Byte 2 of sums 0 and 1's lanes to output bytes 0-3 and 4-7.
+  alignas(16) static constexpr uint8_t kOut0[16] = {
+      2,    6,    10,   14,   0x80, 0x80, 0x80, 0x80,
+      0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
+  alignas(16) static constexpr uint8_t kOut1[16] = {
+      0x80, 0x80, 0x80, 0x80, 2,    6,    10,   14,
+      0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
+  const v_uint8x16 pair_low = v_load(kPairLow);
+  const v_uint8x16 left_right = v_load(kLeftRight);
+  const v_uint8x16 out0 = v_load(kOut0), out1 = v_load(kOut1);
+  int64_t shuffled = 0, portable = 0, scalar = 0;
+  int32_t X = X0, Y = Y0;
+  v_int32x4 Xa = v_setall_s32(X0) + ramp, Ya = v_setall_s32(Y0) + rampy;
+  for (int g = 0; g < n;
+       g += 8, X += 8 * DX, Y += 8 * DY, Xa += dx8, Ya += dy8) {
+    if (g + 8 > n) {  // overlapping last group, as in SampleRow
+      g = n - 8;
+      X = X0 + g * DX;
+      Y = Y0 + g * DY;
+      Xa = v_setall_s32(X) + ramp;
+      Ya = v_setall_s32(Y) + rampy;
+    }
+    const int u = u0 + g;
+    const int ix0 = X >> shift, iy0 = Y >> shift;
+    const int iy7 = (Y + 7 * DY) >> shift;
+    const v_int32x4 Xb = Xa + dx4, Yb = Ya + dy4;
+    if (iy0 != iy7 ||
+        (!whole &&
+         (static_cast<unsigned>(((X + 7 * DX) >> shift) - ix0) > 14u ||
+          ix0 < 0 || ix0 > max_ix_shuffle || iy0 < 0 || iy0 > max_iy))) {
+      if (GroupInside(X, Y, DX, DY, 8, in.cols - 2, max_iy)) {
+        Mono8(base, step, Xa, Xb, Ya, Yb, out + u);
+        portable += 8;
+      } else {
+        for (int k = 0; k < 8; ++k) {
+          SamplePixel(in, 1, (X + k * DX) >> kScanFrac,
+                      (Y + k * DY) >> kScanFrac, out + u + k);
+        }
+        scalar += 8;
+      }
+      continue;
+    }
+    const uchar* p = base + static_cast<size_t>(iy0) * step + ix0;
+    const v_uint8x16 top = v_load(p);
+    const v_uint8x16 bottom = v_load(p + step);
+    // Offsets from ix0 (0..14) and horizontal weight bytes (32 - fx, fx)
+    // = 32 + 255 fx, one 16-bit lane per pixel.
+    const v_int32x4 col0 = v_setall_s32(ix0);
+    const v_uint8x16 rel = v_reinterpret_as_u8(
+        v_pack(v_shr<shift>(Xa) - col0, v_shr<shift>(Xb) - col0));
+    const v_int32x4 fxa = v_shr<kScanFrac>(Xa) & m31;
+    const v_int32x4 fxb = v_shr<kScanFrac>(Xb) & m31;
+    const v_uint8x16 wx = v_reinterpret_as_u8(v_pack(
+        k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fxa), k255)),
+        k32 +
+            v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fxb), k255))));
+    const v_uint8x16 idx = ShuffleBytes(rel, pair_low) + left_right;
+    const v_int16x8 t = MulAddPairs(ShuffleBytes(top, idx), wx);
+    const v_int16x8 b = MulAddPairs(ShuffleBytes(bottom, idx), wx);
+    // Vertical step with 64 ((32 - fy), fy) per 32-bit lane (pixel).
+    const v_int32x4 fya = v_shr<kScanFrac - 6>(Ya) & m31x64;
+    const v_int32x4 fyb = v_shr<kScanFrac - 6>(Yb) & m31x64;
+    const v_int16x8 wya = v_reinterpret_as_s16((k32x64 - fya) | v_shl<16>(fya));
+    const v_int16x8 wyb = v_reinterpret_as_s16((k32x64 - fyb) | v_shl<16>(fyb));
+    v_int16x8 z0, z1;
+    v_zip(t, b, z0, z1);
+    const v_int32x4 h0 = v_dotprod(z0, wya) + half;
+    const v_int32x4 h1 = v_dotprod(z1, wyb) + half;
+    v_store_low(out + u, ShuffleBytes(v_reinterpret_as_u8(h0), out0) |
+                             ShuffleBytes(v_reinterpret_as_u8(h1), out1));
+    shuffled += 8;
+  }
+  counts->shuffle_px += shuffled;
+  counts->portable_simd_px += portable;
+  counts->scalar_px += scalar;
+}
 #endif  // STEADIFACE_SHUFFLE_KERNEL
 
 // One output row. `shuffle`: 3-channel stepped segments go through the
@@ -473,6 +600,10 @@ void SampleRow(const WarpMesh& m, const cv::Mat& in, int width, int v,
 #ifdef STEADIFACE_SHUFFLE_KERNEL
     if (shuffle && cn == 3) {
       Color3SegmentShuffle(seg, in, width, out, counts);
+      return;
+    }
+    if (shuffle && cn == 1) {
+      Mono8SegmentShuffle(seg, in, out, counts);
       return;
     }
 #endif

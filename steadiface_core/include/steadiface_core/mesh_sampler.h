@@ -8,10 +8,10 @@ namespace steadiface {
 
 struct WarpMesh;
 
-/// Which kernel samples 3-channel input.
+/// Which kernel samples 1- and 3-channel input.
 enum class SampleKernel {
-  /// The shuffle kernel where the CPU has it (SSSE3 on x86, any AArch64),
-  /// else the portable one. Both give the same output bit for bit.
+  /// The shuffle kernels where the CPU has them (SSSE3 on x86, any
+  /// AArch64), else the portable one. All give the same output bit for bit.
   kAuto,
   /// The portable universal-intrinsics kernel only (tests, benchmarks).
   kPortable,
@@ -20,7 +20,8 @@ enum class SampleKernel {
 /// How many output pixels each path sampled (a segment's overlapping last
 /// group counts in full, so the sum can exceed width x height slightly).
 struct SampleStats {
-  /// 3 channels, a group of 4 from one 16-byte load per source row.
+  /// Shuffle kernels: a group of 4 (3 channels) or 8 (1 channel) pixels
+  /// from one 16-byte load per source row.
   int64_t shuffle_px = 0;
   /// Universal intrinsics, every pixel's neighbourhood loaded on its own.
   int64_t portable_simd_px = 0;
@@ -29,7 +30,8 @@ struct SampleStats {
   int64_t scalar_px = 0;
 };
 
-/// True when SampleKernel::kAuto runs the shuffle kernel for 3 channels.
+/// True when SampleKernel::kAuto runs the shuffle kernels (1 and 3
+/// channels).
 bool ShuffleKernelAvailable();
 
 /// Renders `output` (width x height, the input's type) by sampling `input`
@@ -46,11 +48,12 @@ bool ShuffleKernelAvailable();
 /// does not depend on the thread count. Rows are split over OpenCV's
 /// threads (cv::parallel_for_).
 ///
-/// 3-channel input (bgr8) goes through a shuffle kernel where the CPU has
-/// one (`kernel`, ShuffleKernelAvailable()): 4 output pixels that read one
-/// source row pair and at most 4 adjacent columns take one 16-byte load per
-/// row and byte shuffles instead of 8 per-pixel loads; same arithmetic, same
-/// output. `stats`, if given, receives the pixel counts per path.
+/// 3- and 1-channel input (bgr8, mono8) goes through shuffle kernels where
+/// the CPU has them (`kernel`, ShuffleKernelAvailable()): 4 (bgr8) or 8
+/// (mono8) output pixels that read one source row pair and one 16-byte span
+/// of it take one load per row and byte shuffles instead of per-pixel
+/// loads; same arithmetic, same output. `stats`, if given, receives the
+/// pixel counts per path.
 void SampleMesh(const WarpMesh& mesh, const cv::Mat& input, int width,
                 int height, cv::Mat* output,
                 SampleKernel kernel = SampleKernel::kAuto,
