@@ -63,8 +63,8 @@ TEST(LandmarkPredictorTest, SameLandmarksAsDlibsShapePredictor) {
 }
 
 // The decoded-model cache gives the very same model: identical landmarks
-// to the last bit on a real photo; a damaged cache file is ignored and
-// rewritten.
+// to the last bit on a real photo, read straight into the packed trees (the
+// fast load); a damaged cache file is ignored and rewritten.
 TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
   char dir_template[] = "/tmp/steadiface_cache_test_XXXXXX";
   ASSERT_NE(mkdtemp(dir_template), nullptr);
@@ -78,6 +78,7 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
     ASSERT_TRUE(
         LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "").ok());
     EXPECT_FALSE(p->loaded_from_cache());
+    EXPECT_FALSE(p->loaded_packed_from_cache());
     ASSERT_TRUE(p->Predict(grey, box, &reference).ok());
   }
   {
@@ -91,6 +92,8 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
     ASSERT_TRUE(
         LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
     EXPECT_TRUE(p->loaded_from_cache());
+    // Straight into the packed trees, not through dlib's structures.
+    EXPECT_TRUE(p->loaded_packed_from_cache());
     ASSERT_TRUE(p->Predict(grey, box, &cached).ok());
   }
   ASSERT_EQ(cached.size(), reference.size());

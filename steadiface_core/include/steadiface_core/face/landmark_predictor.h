@@ -40,6 +40,10 @@ class LandmarkPredictor {
   /// Whether this predictor's model came from the cache (for tests and
   /// logs).
   bool loaded_from_cache() const { return from_cache_; }
+  /// Whether the cache was read straight into the packed trees (the fast
+  /// load: no dlib tree objects); false for a model file, or a cache whose
+  /// trees are not all alike (for tests and logs).
+  bool loaded_packed_from_cache() const { return packed_from_cache_; }
 
   /// Fits the 68 landmarks in `box` (full-image pixels) of `gray`.
   Status Predict(const cv::Mat& gray, const cv::Rect2d& box,
@@ -56,6 +60,7 @@ class LandmarkPredictor {
   struct Impl;
   std::shared_ptr<const Impl> impl_;
   bool from_cache_ = false;
+  bool packed_from_cache_ = false;
 };
 
 }  // namespace steadiface
