@@ -13,12 +13,14 @@
 #include "steadiface_core/mesh_scanline.h"
 #include "steadiface_core/sim/background.h"
 #include "steadiface_core/so3.h"
+#include "affine_mesh.h"
 #include "test_util.h"
 
 namespace steadiface {
 namespace {
 
 using testing_util::At;
+using testing_util::AffineMesh;
 using testing_util::LoadImage;
 
 CameraModel Model(const CameraIntrinsics& k, double zoom = 1.0) {
@@ -499,27 +501,6 @@ TEST(WarperTest, RoundHalfAwayFromZeroIsLround) {
   EXPECT_EQ(RoundHalfAwayFromZero(0.5f), 1);
   EXPECT_EQ(RoundHalfAwayFromZero(-0.5f), -1);
   EXPECT_GT(checked, 400000);
-}
-
-// A mesh of `cells` x `cells` cells over a w x h output whose vertices
-// sample the input at A (u, v) + b: an affine warp made by hand, so the
-// test reaches flips, zoom-out, steep rotations and every edge.
-WarpMesh AffineMesh(int w, int h, int cells, const Eigen::Matrix2f& A,
-                    const Eigen::Vector2f& b) {
-  WarpMesh m;
-  m.cols = m.rows = cells + 1;
-  for (int i = 0; i <= cells; ++i) {
-    m.u.push_back(-0.5 + (w * static_cast<double>(i)) / cells);
-    m.v.push_back(-0.5 + (h * static_cast<double>(i)) / cells);
-  }
-  for (int j = 0; j <= cells; ++j) {
-    for (int i = 0; i <= cells; ++i) {
-      const Eigen::Vector2f uv(static_cast<float>(m.u[i]), static_cast<float>(m.v[j]));
-      m.source.push_back(A * uv + b);
-      m.source_row.push_back(m.source.back().y());
-    }
-  }
-  return m;
 }
 
 // The shuffle kernels (one 16-byte load per source row for 4 bgr8 or 8

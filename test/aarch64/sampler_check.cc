@@ -18,29 +18,12 @@
 #include "steadiface_core/mesh_sampler.h"
 #include "steadiface_core/mesh_scanline.h"
 #include "steadiface_core/warper.h"
+#include "affine_mesh.h"
 
 namespace {
 
 using steadiface::WarpMesh;
-
-WarpMesh AffineMesh(int w, int h, int cells, const Eigen::Matrix2f& A,
-                    const Eigen::Vector2f& b) {
-  WarpMesh m;
-  m.cols = m.rows = cells + 1;
-  for (int i = 0; i <= cells; ++i) {
-    m.u.push_back(-0.5 + (w * static_cast<double>(i)) / cells);
-    m.v.push_back(-0.5 + (h * static_cast<double>(i)) / cells);
-  }
-  for (int j = 0; j <= cells; ++j) {
-    for (int i = 0; i <= cells; ++i) {
-      const Eigen::Vector2f uv(static_cast<float>(m.u[i]),
-                               static_cast<float>(m.v[j]));
-      m.source.push_back(A * uv + b);
-      m.source_row.push_back(m.source.back().y());
-    }
-  }
-  return m;
-}
+using steadiface::testing_util::AffineMesh;
 
 // cv::remap INTER_LINEAR with BORDER_CONSTANT 0 on 1/32 px coordinates,
 // written out plainly: the coordinates come from the same scan segments.

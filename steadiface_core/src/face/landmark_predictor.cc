@@ -207,6 +207,60 @@ class CacheReader {
   const char* end_;
 };
 
+// The header: magic and the model file the cache was decoded from.
+bool ReadCacheHeader(CacheReader* r, const SourceKey& key) {
+  char magic[8];
+  uint64_t size = 0, len = 0;
+  int64_t mtime = 0;
+  std::string canonical;
+  for (char& c : magic) {
+    if (!r->Pod(&c)) return false;
+  }
+  return std::memcmp(magic, kCacheMagic, sizeof(magic)) == 0 && r->Pod(&size) &&
+         r->Pod(&mtime) && r->Count(&len, 1) && r->Bytes(&canonical, len) &&
+         size == key.size && mtime == key.mtime_ns &&
+         canonical == key.canonical;
+}
+
+// The initial (mean) shape, then the number of cascades.
+bool ReadShapeAndCascades(CacheReader* r, dlib::matrix<float, 0, 1>* shape,
+                          uint64_t* n_cascades) {
+  uint64_t n = 0;
+  if (!r->Count(&n, sizeof(float)) || n == 0) return false;
+  shape->set_size(static_cast<long>(n));
+  return r->Floats(&(*shape)(0), n) && r->Count(n_cascades, 8);
+}
+
+// One cascade's feature anchors and deltas (after its trees).
+bool ReadAnchorsAndDeltas(CacheReader* r, std::vector<unsigned long>* anchors,
+                          std::vector<dlib::vector<float, 2>>* deltas) {
+  uint64_t n_anchor = 0, n_deltas = 0;
+  if (!r->Count(&n_anchor, 8)) return false;
+  anchors->resize(n_anchor);
+  for (auto& a : *anchors) {
+    uint64_t v = 0;
+    if (!r->Pod(&v)) return false;
+    a = v;
+  }
+  if (!r->Count(&n_deltas, 8)) return false;
+  deltas->resize(n_deltas);
+  for (auto& d : *deltas) {
+    float x = 0, y = 0;
+    if (!r->Pod(&x) || !r->Pod(&y)) return false;
+    d = dlib::vector<float, 2>(x, y);
+  }
+  return true;
+}
+
+// The closing magic, and nothing after it.
+bool ReadCacheTrailer(CacheReader* r) {
+  char magic[8];
+  for (char& c : magic) {
+    if (!r->Pod(&c)) return false;
+  }
+  return std::memcmp(magic, kCacheMagic, sizeof(magic)) == 0 && r->AtEnd();
+}
+
 // The cache file mapped read-only (no copy into a buffer); unmapped when it
 // goes out of scope.
 class MappedFile {
@@ -256,23 +310,14 @@ bool LandmarkPredictor::Impl::ReadPackedCache(const std::string& file,
   const MappedFile mapped(file);
   if (mapped.data() == nullptr) return false;
   CacheReader r(mapped.data(), mapped.size());
-  char magic[8];
-  uint64_t size = 0, len = 0;
-  int64_t mtime = 0;
-  std::string name;
-  for (char& c : magic) {
-    if (!r.Pod(&c)) return false;
-  }
-  if (std::memcmp(magic, kCacheMagic, sizeof(magic)) != 0 || !r.Pod(&size) ||
-      !r.Pod(&mtime) || !r.Count(&len, 1) || !r.Bytes(&name, len) ||
-      size != source_size || mtime != source_mtime_ns || name != canonical) {
+  uint64_t n_cascades = 0;
+  if (!ReadCacheHeader(&r,
+                       SourceKey{canonical, source_size, source_mtime_ns}) ||
+      !ReadShapeAndCascades(&r, &m->initial_shape, &n_cascades) ||
+      n_cascades == 0) {
     return false;
   }
-  uint64_t n = 0, n_cascades = 0;
-  if (!r.Count(&n, sizeof(float)) || n == 0) return false;
-  m->initial_shape.set_size(static_cast<long>(n));
-  if (!r.Floats(&m->initial_shape(0), n)) return false;
-  if (!r.Count(&n_cascades, 8) || n_cascades == 0) return false;
+  const uint64_t n = static_cast<uint64_t>(m->initial_shape.size());
   m->forests.resize(n_cascades);  // only their count: the trees are packed
   m->anchor_idx.resize(n_cascades);
   m->deltas.resize(n_cascades);
@@ -328,26 +373,11 @@ bool LandmarkPredictor::Impl::ReadPackedCache(const std::string& file,
         dst += n;
       }
     }
-    uint64_t n_anchor = 0, n_deltas = 0;
-    if (!r.Count(&n_anchor, 8)) return false;
-    m->anchor_idx[c].resize(n_anchor);
-    for (auto& a : m->anchor_idx[c]) {
-      uint64_t v = 0;
-      if (!r.Pod(&v)) return false;
-      a = v;
-    }
-    if (!r.Count(&n_deltas, 8)) return false;
-    m->deltas[c].resize(n_deltas);
-    for (auto& d : m->deltas[c]) {
-      float x = 0, y = 0;
-      if (!r.Pod(&x) || !r.Pod(&y)) return false;
-      d = dlib::vector<float, 2>(x, y);
+    if (!ReadAnchorsAndDeltas(&r, &m->anchor_idx[c], &m->deltas[c])) {
+      return false;
     }
   }
-  for (char& c : magic) {
-    if (!r.Pod(&c)) return false;
-  }
-  return std::memcmp(magic, kCacheMagic, sizeof(magic)) == 0 && r.AtEnd();
+  return ReadCacheTrailer(&r);
 }
 
 LandmarkPredictor::LandmarkPredictor() = default;
@@ -390,24 +420,11 @@ Status LandmarkPredictor::Load(const std::string& path,
     std::string buf;
     if (!ReadWholeFile(cache_file, &buf)) return false;
     CacheReader r(buf.data(), buf.size());
-    char magic[8];
-    uint64_t size = 0, len = 0;
-    int64_t mtime = 0;
-    std::string canonical;
-    for (char& c : magic) {
-      if (!r.Pod(&c)) return false;
-    }
-    if (std::memcmp(magic, kCacheMagic, sizeof(magic)) != 0 || !r.Pod(&size) ||
-        !r.Pod(&mtime) || !r.Count(&len, 1) || !r.Bytes(&canonical, len) ||
-        size != key.size || mtime != key.mtime_ns ||
-        canonical != key.canonical) {
+    uint64_t n_cascades = 0;
+    if (!ReadCacheHeader(&r, key) ||
+        !ReadShapeAndCascades(&r, &m->initial_shape, &n_cascades)) {
       return false;
     }
-    uint64_t n_shape = 0, n_cascades = 0;
-    if (!r.Count(&n_shape, sizeof(float)) || n_shape == 0) return false;
-    m->initial_shape.set_size(static_cast<long>(n_shape));
-    if (!r.Floats(&m->initial_shape(0), n_shape)) return false;
-    if (!r.Count(&n_cascades, 8)) return false;
     m->forests.resize(n_cascades);
     m->anchor_idx.resize(n_cascades);
     m->deltas.resize(n_cascades);
@@ -434,26 +451,11 @@ Status LandmarkPredictor::Load(const std::string& path,
           if (k > 0 && !r.Floats(&leaf(0), k)) return false;
         }
       }
-      uint64_t n_anchor = 0, n_deltas = 0;
-      if (!r.Count(&n_anchor, 8)) return false;
-      m->anchor_idx[c].resize(n_anchor);
-      for (auto& a : m->anchor_idx[c]) {
-        uint64_t v = 0;
-        if (!r.Pod(&v)) return false;
-        a = v;
-      }
-      if (!r.Count(&n_deltas, 8)) return false;
-      m->deltas[c].resize(n_deltas);
-      for (auto& d : m->deltas[c]) {
-        float x = 0, y = 0;
-        if (!r.Pod(&x) || !r.Pod(&y)) return false;
-        d = dlib::vector<float, 2>(x, y);
+      if (!ReadAnchorsAndDeltas(&r, &m->anchor_idx[c], &m->deltas[c])) {
+        return false;
       }
     }
-    for (char& c : magic) {
-      if (!r.Pod(&c)) return false;
-    }
-    return std::memcmp(magic, kCacheMagic, sizeof(magic)) == 0 && r.AtEnd();
+    return ReadCacheTrailer(&r);
   };
   // Writes the cache next to nothing else: a temporary file renamed into
   // place, so a reader never sees half a file. Failure is silent.
