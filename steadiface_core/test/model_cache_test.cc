@@ -123,6 +123,34 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
         LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
     EXPECT_TRUE(p->loaded_from_cache());
   }
+  // Damage a count (the number of cascades, to one the file's size would
+  // allow on its own): refused, decoded again from the model file.
+  {
+    std::FILE* f = std::fopen(files[0].c_str(), "r+b");
+    ASSERT_NE(f, nullptr);
+    uint64_t len = 0;
+    ASSERT_EQ(std::fseek(f, 24, SEEK_SET), 0);  // magic, size, mtime
+    ASSERT_EQ(std::fread(&len, sizeof(len), 1, f), 1u);
+    // The name, the shape's count and its 136 floats, then the cascades'.
+    ASSERT_EQ(std::fseek(f, static_cast<long>(32 + len + 8 + 136 * 4), SEEK_SET),
+              0);
+    uint64_t cascades = 0;
+    ASSERT_EQ(std::fread(&cascades, sizeof(cascades), 1, f), 1u);
+    EXPECT_EQ(cascades, 15u);  // the 68-point model's
+    const uint64_t damaged = static_cast<uint64_t>(full_size) / 16;
+    ASSERT_EQ(std::fseek(f, static_cast<long>(32 + len + 8 + 136 * 4), SEEK_SET),
+              0);
+    ASSERT_EQ(std::fwrite(&damaged, sizeof(damaged), 1, f), 1u);
+    std::fclose(f);
+    std::unique_ptr<LandmarkPredictor> p;
+    ASSERT_TRUE(
+        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+    EXPECT_FALSE(p->loaded_from_cache());
+    std::vector<Eigen::Vector2d> again;
+    ASSERT_TRUE(p->Predict(grey, box, &again).ok());
+    ASSERT_EQ(again.size(), reference.size());
+    EXPECT_EQ(again[30].x(), reference[30].x());
+  }
   // An unwritable cache directory is not an error.
   {
     std::unique_ptr<LandmarkPredictor> p;

@@ -318,9 +318,6 @@ bool LandmarkPredictor::Impl::ReadPackedCache(const std::string& file,
     return false;
   }
   const uint64_t n = static_cast<uint64_t>(m->initial_shape.size());
-  m->forests.resize(n_cascades);  // only their count: the trees are packed
-  m->anchor_idx.resize(n_cascades);
-  m->deltas.resize(n_cascades);
   float* dst = nullptr;
   for (uint64_t c = 0; c < n_cascades; ++c) {
     uint64_t n_trees = 0;
@@ -336,7 +333,6 @@ bool LandmarkPredictor::Impl::ReadPackedCache(const std::string& file,
       const bool first = c == 0 && t == 0;
       if (first) {
         m->splits_per_tree = n_splits;
-        m->splits.reserve(n_cascades * n_trees * n_splits);
       } else if (n_splits != m->splits_per_tree) {
         return false;
       }
@@ -362,6 +358,12 @@ bool LandmarkPredictor::Impl::ReadPackedCache(const std::string& file,
         }
         if (!m->AllocateLeaves(static_cast<size_t>(floats))) return false;
         dst = m->leaves;
+        // Sized only now: the leaf block's check above bounds every count
+        // (a damaged cache cannot ask for more than its own size).
+        m->splits.reserve(n_cascades * n_trees * n_splits);
+        m->forests.resize(n_cascades);  // their count only: trees are packed
+        m->anchor_idx.resize(n_cascades);
+        m->deltas.resize(n_cascades);
       } else if (n_leaves != m->leaves_per_tree) {
         return false;
       }
