@@ -373,13 +373,14 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
   std_msgs::Header out_header = in_header;
   out_header.frame_id = camera_frame + wrapper_options_.stabilized_suffix;
   if (!frame.output.empty()) {
-    const std::string enc = frame.output.channels() == 1
-                                ? sensor_msgs::image_encodings::MONO8
-                                : frame.output.channels() == 4 ? sensor_msgs::image_encodings::BGRA8
-                                                               : sensor_msgs::image_encodings::BGR8;
     sensor_msgs::CameraInfoPtr info(
         new sensor_msgs::CameraInfo(ToCameraInfo(frame.output_intrinsics, out_header)));
     if (sink_->WantsImage()) {
+      const std::string enc = frame.output.channels() == 1
+                                  ? sensor_msgs::image_encodings::MONO8
+                                  : frame.output.channels() == 4
+                                        ? sensor_msgs::image_encodings::BGRA8
+                                        : sensor_msgs::image_encodings::BGR8;
       sink_->PublishImage(cv_bridge::CvImage(out_header, enc, frame.output).toImageMsg(), info);
     } else {
       sink_->PublishOutputInfo(info);
