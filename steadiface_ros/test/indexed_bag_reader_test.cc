@@ -325,5 +325,37 @@ TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
   EXPECT_GT(errors[1], 0);
 }
 
+TEST(IndexedBagReaderTest, AFileTruncatedWhileReadGivesAnError) {
+  // The chunks are read with pread() after Open(): a bag cut short by
+  // another process meanwhile ends the read with an error that says so, for
+  // uncompressed and LZ4 chunks. (When the chunks were read through a map,
+  // the cut read as zeros, "bad record in a chunk" or an LZ4 error, and a
+  // page wholly past the cut would have raised SIGBUS.)
+  for (const auto compression :
+       {rosbag::compression::Uncompressed, rosbag::compression::LZ4}) {
+    TempDir dir;
+    const std::string path = dir.File("cut_later.bag");
+    WriteBag(path, compression, 8000, false, /*noisy_images=*/true);
+    const std::vector<char> bytes = Slurp(path);
+    const std::vector<std::string> topics = {"/imu", "/camera/image_raw",
+                                             "camera/camera_info"};
+    const size_t whole = ReadWithView(path, topics).size();
+    IndexedBagReader reader;
+    std::string why;
+    ASSERT_TRUE(reader.Open(path, &why)) << why;
+    reader.Select(topics);
+    IndexedBagReader::Message m;
+    std::string error;
+    ASSERT_TRUE(reader.Next(&m, &error)) << error;
+    ASSERT_EQ(truncate(path.c_str(), static_cast<off_t>(bytes.size() / 3)), 0);
+    size_t n = 1;
+    while (reader.Next(&m, &error)) ++n;
+    EXPECT_NE(error.find("truncated"), std::string::npos)
+        << "after " << n << " messages: '" << error << "'";
+    EXPECT_GT(whole, 400u);
+    EXPECT_LT(n, whole * 2 / 3);
+  }
+}
+
 }  // namespace
 }  // namespace steadiface_bag

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 
 namespace steadiface_bag {
@@ -118,23 +119,25 @@ struct IndexedBagReader::Lz4Context {
 IndexedBagReader::IndexedBagReader(bool verify_checksums)
     : verify_checksums_(verify_checksums), lz4_(new Lz4Context) {}
 
-IndexedBagReader::~IndexedBagReader() { Unmap(); }
-
-void IndexedBagReader::Release(const Chunk& c) {
-  const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
-  const uintptr_t begin = reinterpret_cast<uintptr_t>(c.data) & ~(page - 1);
-  const uintptr_t end = reinterpret_cast<uintptr_t>(c.data) + c.stored_size;
-  madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+IndexedBagReader::~IndexedBagReader() {
+  Unmap();
+  CloseFile();
 }
 
 void IndexedBagReader::Unmap() {
   if (file_ != nullptr) munmap(const_cast<uint8_t*>(file_), file_size_);
   file_ = nullptr;
+}
+
+void IndexedBagReader::CloseFile() {
+  if (fd_ >= 0) close(fd_);
+  fd_ = -1;
   file_size_ = 0;
 }
 
 bool IndexedBagReader::Open(const std::string& path, std::string* why) {
   Unmap();
+  CloseFile();
   connections_.clear();
   indexes_.clear();
   chunks_.clear();
@@ -142,46 +145,69 @@ bool IndexedBagReader::Open(const std::string& path, std::string* why) {
   cursors_.clear();
   started_ = false;
   cached_pos_ = UINT64_MAX;
-  last_pos_ = UINT64_MAX;
   if (lz4_->ctx == nullptr) {
     *why = "no LZ4 decompression context";
     return false;
   }
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
+  fd_ = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) {
     *why = "cannot open " + path + ": " + std::strerror(errno);
     return false;
   }
   struct stat st;
-  if (fstat(fd, &st) != 0 || st.st_size <= 0) {
-    close(fd);
+  if (fstat(fd_, &st) != 0 || st.st_size <= 0) {
+    CloseFile();
     *why = "cannot size " + path;
     return false;
   }
-  void* m = mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ,
-                 MAP_PRIVATE, fd, 0);
-  close(fd);
+  file_size_ = static_cast<uint64_t>(st.st_size);
+  // The index is read through a map (its records lie after every chunk),
+  // the chunks later with pread().
+  void* m = mmap(nullptr, file_size_, PROT_READ, MAP_PRIVATE, fd_, 0);
   if (m == MAP_FAILED) {
     *why = "cannot map " + path + ": " + std::strerror(errno);
+    CloseFile();
     return false;
   }
   file_ = static_cast<const uint8_t*>(m);
-  file_size_ = static_cast<uint64_t>(st.st_size);
-  // Read in order, mostly: let the kernel read ahead.
-  madvise(m, file_size_, MADV_SEQUENTIAL);
+  madvise(m, file_size_, MADV_RANDOM);
   bool ok = false;
   try {
     ok = ReadIndex(why);
   } catch (const std::exception& e) {  // ros::Time out of range, no memory
     *why = std::string("bad index: ") + e.what();
   }
+  Unmap();
   if (!ok) {
-    Unmap();
+    CloseFile();
     connections_.clear();
     indexes_.clear();
     chunks_.clear();
+    return false;
   }
-  return ok;
+  // The chunks are read in order, mostly: let the kernel read ahead.
+  posix_fadvise(fd_, 0, 0, POSIX_FADV_SEQUENTIAL);
+  return true;
+}
+
+bool IndexedBagReader::ReadAt(uint64_t offset, uint32_t size, uint8_t* out,
+                              std::string* error) const {
+  uint64_t done = 0;
+  while (done < size) {
+    const ssize_t n = pread(fd_, out + done, size - done,
+                            static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      *error = std::string("cannot read a chunk: ") + std::strerror(errno);
+      return false;
+    }
+    if (n == 0) {
+      *error = "the bag ends inside a chunk (truncated while read?)";
+      return false;
+    }
+    done += static_cast<uint64_t>(n);
+  }
+  return true;
 }
 
 bool IndexedBagReader::ReadIndex(std::string* why) {
@@ -261,7 +287,7 @@ bool IndexedBagReader::ReadIndex(std::string* why) {
       *why = "chunks compressed with " + chunk.compression;
       return false;
     }
-    chunk.data = r.data;
+    chunk.data_offset = static_cast<uint64_t>(r.data - file_);
     chunk.stored_size = r.data_size;
     if (chunk.compression == "none" && chunk.size != chunk.stored_size) {
       *why = "uncompressed chunk of the wrong size";
@@ -320,18 +346,20 @@ const uint8_t* IndexedBagReader::ChunkData(uint64_t pos, uint32_t* size,
   }
   const Chunk& c = it->second;
   *size = c.size;
-  if (last_pos_ != pos) {
-    // Moving to another chunk: let go of the last one's pages, so the
-    // resident size stays about one chunk whatever the bag's size (they
-    // are read again from the page cache if View's order comes back).
-    auto last = chunks_.find(last_pos_);
-    if (last != chunks_.end()) Release(last->second);
-    last_pos_ = pos;
-  }
-  if (c.compression == "none") return c.data;
   if (cached_pos_ == pos) return cached_.data();
   cached_pos_ = UINT64_MAX;
   cached_.resize(c.size);
+  if (c.compression == "none") {
+    if (!ReadAt(c.data_offset, c.stored_size, cached_.data(), error)) {
+      return nullptr;
+    }
+    cached_pos_ = pos;
+    return cached_.data();
+  }
+  stored_.resize(c.stored_size);
+  if (!ReadAt(c.data_offset, c.stored_size, stored_.data(), error)) {
+    return nullptr;
+  }
   LZ4F_decompressOptions_t options;
   std::memset(&options, 0, sizeof(options));
   options.skipChecksums = verify_checksums_ ? 0 : 1;
@@ -340,7 +368,7 @@ const uint8_t* IndexedBagReader::ChunkData(uint64_t pos, uint32_t* size,
   // One frame per chunk; the loop covers a decoder that stops early.
   while (hint != 0 && in < c.stored_size && out < c.size) {
     size_t dst = c.size - out, src = c.stored_size - in;
-    hint = LZ4F_decompress(lz4_->ctx, cached_.data() + out, &dst, c.data + in,
+    hint = LZ4F_decompress(lz4_->ctx, cached_.data() + out, &dst, stored_.data() + in,
                            &src, &options);
     if (LZ4F_isError(hint)) {
       *error = std::string("LZ4 chunk: ") + LZ4F_getErrorName(hint);

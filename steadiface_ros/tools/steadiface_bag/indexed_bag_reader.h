@@ -14,8 +14,12 @@ namespace steadiface_bag {
 /// A reader for indexed ROS bag files (format 2.0) that yields the messages
 /// of the chosen topics in exactly rosbag::View's order, with less work per
 /// message:
-///  - the file is memory-mapped, and a message in an uncompressed chunk is
-///    handed out where it lies in the file (no copy);
+///  - the index is read from a memory map of the file, which is dropped
+///    once Open() is done; each chunk is then read with one pread() into a
+///    buffer that is reused (a mapped chunk costs a page fault per 16
+///    pages on first touch: 0.43 s against 0.07 s for the 630 MB of the
+///    speed protocol's clip, see docs/benchmarks.md), and a file that is
+///    truncated while it is read gives an error that says so;
 ///  - an LZ4 chunk is decompressed once by liblz4's frame decoder, by
 ///    default with its checksums skipped (rosbag's roslz4 computes XXH32
 ///    over every byte, which costs as much as the decompression itself).
@@ -43,7 +47,7 @@ class IndexedBagReader {
     std::string datatype;
   };
   /// One message. `data` stays valid until the next call to Next() or
-  /// Select() (it points into the mapped file or a decompressed chunk).
+  /// Select() (it points into the chunk buffer).
   struct Message {
     uint32_t connection = 0;
     ros::Time time;
@@ -58,7 +62,7 @@ class IndexedBagReader {
   IndexedBagReader(const IndexedBagReader&) = delete;
   IndexedBagReader& operator=(const IndexedBagReader&) = delete;
 
-  /// Maps `path` and reads its index. False, with the reason in *why, if
+  /// Opens `path` and reads its index. False, with the reason in *why, if
   /// the file cannot be opened or is a bag this reader does not handle.
   bool Open(const std::string& path, std::string* why);
   /// Connection id -> topic and type, for every connection in the bag.
@@ -90,20 +94,23 @@ class IndexedBagReader {
   };
   struct Chunk {
     std::string compression;
-    uint32_t size = 0;              // uncompressed
-    const uint8_t* data = nullptr;  // in the file
+    uint32_t size = 0;         // uncompressed
+    uint64_t data_offset = 0;  // of the stored bytes, in the file
     uint32_t stored_size = 0;
   };
 
   bool ReadIndex(std::string* why);
-  /// The chunk at `pos`'s records, decompressed (or in place); null with
+  /// The chunk at `pos`'s records, read and decompressed; null with
   /// *error on failure.
   const uint8_t* ChunkData(uint64_t pos, uint32_t* size, std::string* error);
-  /// Drops a chunk's pages from the mapping (the file is unchanged).
-  static void Release(const Chunk& c);
+  /// Reads `size` bytes at `offset` of the file into `out`.
+  bool ReadAt(uint64_t offset, uint32_t size, uint8_t* out,
+              std::string* error) const;
   void Unmap();
+  void CloseFile();
 
-  const uint8_t* file_ = nullptr;
+  int fd_ = -1;
+  const uint8_t* file_ = nullptr;  // the map, during Open() only
   uint64_t file_size_ = 0;
   std::map<uint32_t, Connection> connections_;
   std::map<uint32_t, Index> indexes_;
@@ -115,8 +122,8 @@ class IndexedBagReader {
   // The one decompressed chunk kept (View's order reads a chunk's messages
   // together unless the bag's chunks overlap in time).
   uint64_t cached_pos_ = UINT64_MAX;
-  uint64_t last_pos_ = UINT64_MAX;  // the chunk the last message came from
   std::vector<uint8_t> cached_;
+  std::vector<uint8_t> stored_;  // an LZ4 chunk's bytes as stored
   struct Lz4Context;
   std::unique_ptr<Lz4Context> lz4_;
 };
