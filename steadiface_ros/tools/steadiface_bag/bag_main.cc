@@ -364,8 +364,8 @@ int main(int argc, char** argv) {
               << elapsed << " s ("
               << ws.counters.frames_out / std::max(elapsed, 1e-9) << " fps)"
               << (a.out.empty() ? "" : ", wrote " + a.out)
-              << (a.video.empty() ? "" : ", " + a.video)
+              << (a.video.empty() || video.failed() ? "" : ", " + a.video)
               << (a.report.empty() ? "" : ", " + a.report) << "\n";
   }
-  return ws.counters.frames_out > 0 ? 0 : 1;
+  return ws.counters.frames_out > 0 && !video.failed() ? 0 : 1;
 }

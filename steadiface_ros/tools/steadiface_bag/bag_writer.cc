@@ -121,17 +121,18 @@ void SideBySideVideo::AddOutput(BagSink* sink) {
   cv::hconcat(left, right, both);
   if (!queue_) {  // first frame: open (the encoder thread owns video_ after)
     const double fps = 30.0;
-    video_.open(tmp_, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps,
-                both.size());
-    if (!video_.isOpened()) {
-      std::cerr << "steadiface_bag: cannot write video '" << tmp_ << "'\n";
+    std::string why;
+    video_ = OpenVideoEncoder(tmp_, fps, both.size(), &why);
+    if (!video_) {
+      std::cerr << "steadiface_bag: " << why << "\n";
       path_.clear();
+      failed_ = true;
       return;
     }
     queue_.reset(new BoundedQueue<cv::Mat>(8));
     thread_ = std::thread([this] {
       cv::Mat frame;
-      while (queue_->Pop(&frame)) video_.write(frame);
+      while (queue_->Pop(&frame)) video_->Write(frame);
     });
   }
   queue_->Push(both);
@@ -144,8 +145,9 @@ void SideBySideVideo::Finish() {
     queue_->Close();
     thread_.join();
   }
-  if (video_.isOpened()) {
-    video_.release();
+  if (video_) {
+    video_->Close();
+    video_.reset();
     std::rename(tmp_.c_str(), path_.c_str());
   }
 }

@@ -8,9 +8,10 @@
 #include <vector>
 
 #include <rosbag/bag.h>
-#include <opencv2/videoio.hpp>
+#include <opencv2/core.hpp>
 
 #include "steadiface_bag/bounded_queue.h"
+#include "steadiface_bag/video_encoder.h"
 #include "steadiface_ros/stabilizer_wrapper.h"
 
 namespace steadiface_bag {
@@ -88,6 +89,8 @@ class SideBySideVideo {
   explicit SideBySideVideo(const std::string& path);
   ~SideBySideVideo();
   bool enabled() const { return !path_.empty(); }
+  /// A video was asked for and could not be written.
+  bool failed() const { return failed_; }
   /// An input frame as it enters the stabilizer.
   void AddInput(const sensor_msgs::Image& image);
   /// Pairs the sink's newest stabilized output (if any) with its input.
@@ -97,8 +100,9 @@ class SideBySideVideo {
 
  private:
   std::string path_, tmp_;
+  bool failed_ = false;
   std::map<ros::Time, cv::Mat> inputs_;  // bounded
-  cv::VideoWriter video_;
+  std::unique_ptr<VideoEncoder> video_;
   std::unique_ptr<BoundedQueue<cv::Mat>> queue_;
   std::thread thread_;  // owns video_ once started
 };
