@@ -325,6 +325,53 @@ TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
   EXPECT_GT(errors[1], 0);
 }
 
+TEST(IndexedBagReaderTest, ChunksWhoseTimesMeetAreReadOnce) {
+  // As steadiface_simulate writes: per frame the IMU samples, then the
+  // image and its camera_info with one stamp. The image closes its chunk,
+  // so the camera_info opens the next one at the same time, and View's order
+  // goes back and forth across that boundary. Each chunk must still be read
+  // and decompressed once (with one chunk kept, most were read twice).
+  for (const auto compression :
+       {rosbag::compression::Uncompressed, rosbag::compression::LZ4}) {
+    TempDir dir;
+    const std::string path = dir.File("meeting.bag");
+    {
+      rosbag::Bag bag(path, rosbag::bagmode::Write);
+      bag.setCompression(compression);
+      bag.setChunkThreshold(2000);  // below one 64 x 64 image
+      const ros::Time t0(1700000000, 0);
+      for (int i = 0; i < 40; ++i) {
+        for (int k = 0; k < 7; ++k) {
+          sensor_msgs::Imu imu;
+          imu.header.seq = i * 7 + k;
+          bag.write("/imu", t0 + ros::Duration(0.005 * (i * 7 + k)), imu);
+        }
+        const ros::Time ti = t0 + ros::Duration(0.005 * (i * 7 + 6));
+        bag.write("/camera/image_raw", ti, MakeImage(i, /*noise=*/true));
+        sensor_msgs::CameraInfo info;
+        info.header.seq = i;
+        bag.write("/camera/camera_info", ti, info);
+      }
+    }
+    const std::vector<std::string> topics = {"/imu", "/camera/image_raw",
+                                             "/camera/camera_info"};
+    IndexedBagReader reader;
+    std::string why, error;
+    ASSERT_TRUE(reader.Open(path, &why)) << why;
+    reader.Select(topics);
+    std::vector<Seen> seen;
+    IndexedBagReader::Message m;
+    while (reader.Next(&m, &error)) {
+      seen.push_back(Seen{reader.connections().at(m.connection).topic, m.time,
+                          std::vector<uint8_t>(m.data, m.data + m.size)});
+    }
+    EXPECT_TRUE(error.empty()) << error;
+    EXPECT_EQ(seen, ReadWithView(path, topics));
+    EXPECT_GE(reader.chunk_count(), 40u);
+    EXPECT_EQ(reader.chunks_read(), reader.chunk_count());
+  }
+}
+
 TEST(IndexedBagReaderTest, AFileTruncatedWhileReadGivesAnError) {
   // The chunks are read with pread() after Open(): a bag cut short by
   // another process meanwhile ends the read with an error that says so, for

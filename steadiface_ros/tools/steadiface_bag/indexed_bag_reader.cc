@@ -144,7 +144,8 @@ bool IndexedBagReader::Open(const std::string& path, std::string* why) {
   ranges_.clear();
   cursors_.clear();
   started_ = false;
-  cached_pos_ = UINT64_MAX;
+  for (CachedChunk& c : cached_) c.pos = UINT64_MAX;
+  chunks_read_ = 0;
   if (lz4_->ctx == nullptr) {
     *why = "no LZ4 decompression context";
     return false;
@@ -346,15 +347,25 @@ const uint8_t* IndexedBagReader::ChunkData(uint64_t pos, uint32_t* size,
   }
   const Chunk& c = it->second;
   *size = c.size;
-  if (cached_pos_ == pos) return cached_.data();
-  cached_pos_ = UINT64_MAX;
-  cached_.resize(c.size);
+  for (int i = 0; i < 2; ++i) {
+    if (cached_[i].pos == pos) {
+      last_cached_ = i;
+      return cached_[i].data.data();
+    }
+  }
+  // Into the slot not used last (the message handed out before this call
+  // is no longer valid, whichever slot it was in).
+  last_cached_ = 1 - last_cached_;
+  CachedChunk& slot = cached_[last_cached_];
+  slot.pos = UINT64_MAX;
+  slot.data.resize(c.size);
+  ++chunks_read_;
   if (c.compression == "none") {
-    if (!ReadAt(c.data_offset, c.stored_size, cached_.data(), error)) {
+    if (!ReadAt(c.data_offset, c.stored_size, slot.data.data(), error)) {
       return nullptr;
     }
-    cached_pos_ = pos;
-    return cached_.data();
+    slot.pos = pos;
+    return slot.data.data();
   }
   stored_.resize(c.stored_size);
   if (!ReadAt(c.data_offset, c.stored_size, stored_.data(), error)) {
@@ -368,7 +379,7 @@ const uint8_t* IndexedBagReader::ChunkData(uint64_t pos, uint32_t* size,
   // One frame per chunk; the loop covers a decoder that stops early.
   while (hint != 0 && in < c.stored_size && out < c.size) {
     size_t dst = c.size - out, src = c.stored_size - in;
-    hint = LZ4F_decompress(lz4_->ctx, cached_.data() + out, &dst, stored_.data() + in,
+    hint = LZ4F_decompress(lz4_->ctx, slot.data.data() + out, &dst, stored_.data() + in,
                            &src, &options);
     if (LZ4F_isError(hint)) {
       *error = std::string("LZ4 chunk: ") + LZ4F_getErrorName(hint);
@@ -384,8 +395,8 @@ const uint8_t* IndexedBagReader::ChunkData(uint64_t pos, uint32_t* size,
     *error = "LZ4 chunk decompressed to the wrong size";
     return nullptr;
   }
-  cached_pos_ = pos;
-  return cached_.data();
+  slot.pos = pos;
+  return slot.data.data();
 }
 
 bool IndexedBagReader::Next(Message* m, std::string* error) {

@@ -75,6 +75,10 @@ class IndexedBagReader {
   /// The next message in View's order. False at the end, or on corrupt
   /// data with *error set (then the iteration stops).
   bool Next(Message* m, std::string* error);
+  /// How many times a chunk was read (and decompressed) since Open().
+  size_t chunks_read() const { return chunks_read_; }
+  /// The number of chunks in the bag.
+  size_t chunk_count() const { return chunks_.size(); }
 
  private:
   struct IndexEntry {
@@ -119,10 +123,18 @@ class IndexedBagReader {
   std::vector<Cursor> cursors_;
   const bool verify_checksums_;
   bool started_ = false;
-  // The one decompressed chunk kept (View's order reads a chunk's messages
-  // together unless the bag's chunks overlap in time).
-  uint64_t cached_pos_ = UINT64_MAX;
-  std::vector<uint8_t> cached_;
+  // The two chunks read last, decompressed. View's order can go back and
+  // forth between neighbouring chunks where their times meet (in bags
+  // written by steadiface_simulate it did at every chunk boundary, and with
+  // one chunk kept every chunk was read and decompressed twice); otherwise
+  // it reads a chunk's messages together.
+  struct CachedChunk {
+    uint64_t pos = UINT64_MAX;
+    std::vector<uint8_t> data;
+  };
+  CachedChunk cached_[2];
+  int last_cached_ = 0;  // the slot used last
+  size_t chunks_read_ = 0;
   std::vector<uint8_t> stored_;  // an LZ4 chunk's bytes as stored
   struct Lz4Context;
   std::unique_ptr<Lz4Context> lz4_;
