@@ -13,6 +13,7 @@
 // thread runs the wrapper exactly as the nodelet's callbacks would (same
 // order, same results); the writer drains a bounded queue of bag writes.
 // Bounded both ways, so memory stays at a few frames whatever the bag size.
+#include <malloc.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -102,6 +103,14 @@ int Usage() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // An offline batch run: freed memory stays in the allocator for the next
+  // frame's buffers (images of several MB, which glibc would otherwise map
+  // and unmap, or trim off its heap) instead of going back to the kernel
+  // and coming back as fresh pages, each cleared and faulted in again.
+  // Peak memory is unchanged (maximum RSS 204-208 MB either way on the speed
+  // protocol's clip); minor page faults 25 000 -> 18 600.
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
   Args a;
   for (int i = 1; i < argc; ++i) {
     const std::string s = argv[i];
