@@ -21,14 +21,33 @@ BagReader::~BagReader() { Join(); }
 
 steadiface::Status BagReader::Open(bool info_required) {
   using steadiface::Status;
-  try {
-    bag_.open(path_, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    return Status::Error("cannot open '" + path_ + "': " + e.what());
+  std::map<std::string, std::string> types;  // topic -> type
+  // The indexed reader first: a rosbag::Bag is not even constructed when it
+  // reads the bag (constructing one loads rosbag's encryptor plugins, about
+  // 40 ms of every start).
+  std::string why_not_indexed;
+  if (use_indexed_reader_) {
+    fast_.reset(new IndexedBagReader(verify_checksums_));
+    if (fast_->Open(path_, &why_not_indexed)) {
+      for (const auto& c : fast_->connections()) {
+        types[NormalizeTopic(c.second.topic)] = c.second.datatype;
+      }
+    } else {
+      fast_.reset();  // rosbag reads what it refuses, or says what is wrong
+    }
   }
-  std::map<std::string, std::string> types;
-  {
-    rosbag::View all(bag_);
+  if (!fast_) {
+    bag_.reset(new rosbag::Bag);
+    try {
+      bag_->open(path_, rosbag::bagmode::Read);
+    } catch (const rosbag::BagException& e) {
+      return Status::Error("cannot open '" + path_ + "': " + e.what());
+    }
+    if (!why_not_indexed.empty()) {
+      std::cerr << "steadiface_bag: reading " << path_
+                << " through rosbag::View (" << why_not_indexed << ")\n";
+    }
+    rosbag::View all(*bag_);
     for (const rosbag::ConnectionInfo* c : all.getConnections()) {
       types[NormalizeTopic(c->topic)] = c->datatype;
     }
@@ -67,15 +86,6 @@ steadiface::Status BagReader::Open(bool info_required) {
       has_info_ = true;
     }
   }
-  if (use_indexed_reader_) {
-    fast_.reset(new IndexedBagReader(verify_checksums_));
-    std::string why;
-    if (!fast_->Open(path_, &why)) {
-      std::cerr << "steadiface_bag: reading " << path_ << " through rosbag::View (" << why
-                << ")\n";
-      fast_.reset();
-    }
-  }
   return Status::Ok();
 }
 
@@ -87,7 +97,9 @@ std::vector<std::string> BagReader::WithAndWithoutSlash(
 }
 
 size_t BagReader::ImageCount() const {
-  return rosbag::View(bag_,
+  if (fast_) return fast_->Count(WithAndWithoutSlash(topics_.image));
+  if (!bag_) return 0;
+  return rosbag::View(*bag_,
                       rosbag::TopicQuery(WithAndWithoutSlash(topics_.image)))
       .size();
 }
@@ -166,8 +178,8 @@ void BagReader::Start(BoundedQueue<BagItem>* queue) {
           if (!dispatch(topic, m.time, as)) break;
         }
         if (!err.empty()) error_ = err;
-      } else {
-        rosbag::View view(bag_, rosbag::TopicQuery(topics));
+      } else if (bag_) {
+        rosbag::View view(*bag_, rosbag::TopicQuery(topics));
         for (const rosbag::MessageInstance& m : view) {
           auto as = [&m](auto* type) {
             using M = std::remove_pointer_t<decltype(type)>;

@@ -82,7 +82,7 @@ class BagReader {
   std::string Join();
   void Close() {
     fast_.reset();
-    bag_.close();
+    if (bag_) bag_->close();
   }
   /// Whether the messages are read through IndexedBagReader (after Open).
   bool indexed() const { return fast_ != nullptr; }
@@ -94,7 +94,7 @@ class BagReader {
   const BagTopics topics_;
   const bool use_indexed_reader_;
   const bool verify_checksums_;
-  rosbag::Bag bag_;
+  std::unique_ptr<rosbag::Bag> bag_;  // only when fast_ cannot read the bag
   std::unique_ptr<IndexedBagReader> fast_;
   bool has_info_ = false;
   bool compressed_ = false;

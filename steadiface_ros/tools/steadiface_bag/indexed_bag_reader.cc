@@ -324,6 +324,17 @@ bool IndexedBagReader::ReadIndex(std::string* why) {
   return true;
 }
 
+size_t IndexedBagReader::Count(const std::vector<std::string>& topics) const {
+  size_t n = 0;
+  for (const auto& c : connections_) {
+    if (std::find(topics.begin(), topics.end(), c.second.topic) == topics.end())
+      continue;
+    auto it = indexes_.find(c.first);
+    if (it != indexes_.end()) n += it->second.size();
+  }
+  return n;
+}
+
 void IndexedBagReader::Select(const std::vector<std::string>& topics) {
   ranges_.clear();
   cursors_.clear();

@@ -69,6 +69,9 @@ class IndexedBagReader {
   const std::map<uint32_t, Connection>& connections() const {
     return connections_;
   }
+  /// The number of messages whose connection's topic is one of `topics`
+  /// (as rosbag::View(bag, TopicQuery(topics)).size()).
+  size_t Count(const std::vector<std::string>& topics) const;
   /// Iterates the messages whose connection's topic is one of `topics`
   /// (compared as stored in the bag), from the first.
   void Select(const std::vector<std::string>& topics);
