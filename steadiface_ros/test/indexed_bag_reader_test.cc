@@ -170,6 +170,12 @@ TEST_P(IndexedBagReaderOrderTest, SameMessagesAndOrderAsRosbagView) {
         std::vector<std::string>{"/camera/image_raw"},
         std::vector<std::string>{"nothing"}}) {
     const std::vector<Seen> want = ReadWithView(path, topics);
+    {
+      IndexedBagReader counter;
+      std::string why;
+      ASSERT_TRUE(counter.Open(path, &why)) << why;
+      EXPECT_EQ(counter.Count(topics), want.size()) << topics.front();
+    }
     for (bool verify : {false, true}) {
       std::string error;
       const std::vector<Seen> got = ReadIndexed(path, topics, verify, &error);
