@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -297,6 +298,27 @@ TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
     std::string why;
     EXPECT_FALSE(reader.Open(path, &why));
     EXPECT_NE(why.find("bad index"), std::string::npos) << why;
+  }
+  // A chunk header stating an uncompressed size its LZ4 data cannot hold
+  // (damage): refused at Open, not allocated (4 GB) when the chunk is read.
+  {
+    std::vector<char> bad = bytes;
+    const std::string field = "compression=lz4";
+    const auto at = std::search(bad.begin(), bad.end(), field.begin(), field.end());
+    ASSERT_NE(at, bad.end());
+    // The chunk header's next field: <len>"size=" + 4 bytes.
+    const std::string size_field = "size=";
+    const auto sz = std::search(at, bad.end(), size_field.begin(), size_field.end());
+    ASSERT_NE(sz, bad.end());
+    ASSERT_LT(sz - at, 64);
+    const uint32_t huge = 0xfffffff0u;
+    std::memcpy(&*(sz + size_field.size()), &huge, 4);
+    const std::string path = dir.File("huge_size.bag");
+    Spill(path, bad);
+    IndexedBagReader reader;
+    std::string why;
+    EXPECT_FALSE(reader.Open(path, &why));
+    EXPECT_NE(why.find("impossible size"), std::string::npos) << why;
   }
   // Noise over the first half of the file, which is mostly LZ4 chunk data
   // (pseudo-random images do not compress): every Next either gives a

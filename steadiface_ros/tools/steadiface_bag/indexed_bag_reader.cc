@@ -294,6 +294,14 @@ bool IndexedBagReader::ReadIndex(std::string* why) {
       *why = "uncompressed chunk of the wrong size";
       return false;
     }
+    // LZ4 expands at most 255-fold (a match's length costs at least one byte
+    // per 255): a larger stated size is damage, refused here rather than
+    // allocated and cleared when the chunk is read.
+    if (chunk.compression == "lz4" &&
+        chunk.size > 255ull * chunk.stored_size + 65536) {
+      *why = "LZ4 chunk states an impossible size";
+      return false;
+    }
     uint64_t q = ci.first + r.total_size;
     for (uint32_t k = 0; k < ci.second; ++k) {
       uint32_t ver = 0, conn = 0, count = 0;
