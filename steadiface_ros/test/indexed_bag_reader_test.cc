@@ -256,6 +256,16 @@ void Spill(const std::string& path, const std::vector<char>& bytes) {
   std::ofstream(path, std::ios::binary).write(bytes.data(), bytes.size());
 }
 
+// Writes `bytes` to `path`: Open must refuse it, saying `reason`.
+void ExpectRefused(const std::string& path, const std::vector<char>& bytes,
+                   const std::string& reason) {
+  Spill(path, bytes);
+  IndexedBagReader reader;
+  std::string why;
+  EXPECT_FALSE(reader.Open(path, &why)) << path;
+  EXPECT_NE(why.find(reason), std::string::npos) << why;
+}
+
 TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
   TempDir dir;
   const std::string good = dir.File("good.bag");
@@ -292,12 +302,7 @@ TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
       }
     }
     ASSERT_GT(hits, 0u);
-    const std::string path = dir.File("bad_time.bag");
-    Spill(path, bad);
-    IndexedBagReader reader;
-    std::string why;
-    EXPECT_FALSE(reader.Open(path, &why));
-    EXPECT_NE(why.find("bad index"), std::string::npos) << why;
+    ExpectRefused(dir.File("bad_time.bag"), bad, "bad index");
   }
   // A chunk header stating an uncompressed size its LZ4 data cannot hold
   // (damage): refused at Open, not allocated (4 GB) when the chunk is read.
@@ -313,12 +318,7 @@ TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
     ASSERT_LT(sz - at, 64);
     const uint32_t huge = 0xfffffff0u;
     std::memcpy(&*(sz + size_field.size()), &huge, 4);
-    const std::string path = dir.File("huge_size.bag");
-    Spill(path, bad);
-    IndexedBagReader reader;
-    std::string why;
-    EXPECT_FALSE(reader.Open(path, &why));
-    EXPECT_NE(why.find("impossible size"), std::string::npos) << why;
+    ExpectRefused(dir.File("huge_size.bag"), bad, "impossible size");
   }
   // Noise over the first half of the file, which is mostly LZ4 chunk data
   // (pseudo-random images do not compress): every Next either gives a
