@@ -96,41 +96,43 @@ inline cv::v_int32x4 Vertical(const cv::v_int16x8& top_bottom,
 inline void Mono8(const uchar* base, size_t step, const cv::v_int32x4& Xa,
                   const cv::v_int32x4& Xb, const cv::v_int32x4& Ya,
                   const cv::v_int32x4& Yb, uchar* out) {
-  using namespace cv;
-  const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
-  const v_int32x4 k32 = v_setall_s32(kInterTabSize);
+  const cv::v_int32x4 m31 = cv::v_setall_s32(kInterTabSize - 1);
+  const cv::v_int32x4 k32 = cv::v_setall_s32(kInterTabSize);
   int ix[8], iy[8];
-  v_store(ix, v_shr<kScanFrac + kInterBits>(Xa));
-  v_store(ix + 4, v_shr<kScanFrac + kInterBits>(Xb));
-  v_store(iy, v_shr<kScanFrac + kInterBits>(Ya));
-  v_store(iy + 4, v_shr<kScanFrac + kInterBits>(Yb));
+  cv::v_store(ix, cv::v_shr<kScanFrac + kInterBits>(Xa));
+  cv::v_store(ix + 4, cv::v_shr<kScanFrac + kInterBits>(Xb));
+  cv::v_store(iy, cv::v_shr<kScanFrac + kInterBits>(Ya));
+  cv::v_store(iy + 4, cv::v_shr<kScanFrac + kInterBits>(Yb));
   // Vectors built from registers (no store-to-load round trip).
   const uchar* p[8];
   for (int k = 0; k < 8; ++k)
     p[k] = base + static_cast<size_t>(iy[k]) * step + ix[k];
-  const v_uint16x8 T(Load16(p[0]), Load16(p[1]), Load16(p[2]), Load16(p[3]),
-                     Load16(p[4]), Load16(p[5]), Load16(p[6]), Load16(p[7]));
-  const v_uint16x8 B(Load16(p[0] + step), Load16(p[1] + step),
-                     Load16(p[2] + step), Load16(p[3] + step),
-                     Load16(p[4] + step), Load16(p[5] + step),
-                     Load16(p[6] + step), Load16(p[7] + step));
-  const v_uint16x8 lo8 = v_setall_u16(0xFF);
-  const v_int32x4 fxa = v_shr<kScanFrac>(Xa) & m31,
-                  fxb = v_shr<kScanFrac>(Xb) & m31;
-  const v_int32x4 fya = v_shr<kScanFrac>(Ya) & m31,
-                  fyb = v_shr<kScanFrac>(Yb) & m31;
-  const v_uint16x8 fx = v_reinterpret_as_u16(v_pack(fxa, fxb));
-  const v_uint16x8 gx = v_setall_u16(kInterTabSize) - fx;
+  const cv::v_uint16x8 T(Load16(p[0]), Load16(p[1]), Load16(p[2]), Load16(p[3]),
+                         Load16(p[4]), Load16(p[5]), Load16(p[6]),
+                         Load16(p[7]));
+  const cv::v_uint16x8 B(Load16(p[0] + step), Load16(p[1] + step),
+                         Load16(p[2] + step), Load16(p[3] + step),
+                         Load16(p[4] + step), Load16(p[5] + step),
+                         Load16(p[6] + step), Load16(p[7] + step));
+  const cv::v_uint16x8 lo8 = cv::v_setall_u16(0xFF);
+  const cv::v_int32x4 fxa = cv::v_shr<kScanFrac>(Xa) & m31,
+                      fxb = cv::v_shr<kScanFrac>(Xb) & m31;
+  const cv::v_int32x4 fya = cv::v_shr<kScanFrac>(Ya) & m31,
+                      fyb = cv::v_shr<kScanFrac>(Yb) & m31;
+  const cv::v_uint16x8 fx = cv::v_reinterpret_as_u16(cv::v_pack(fxa, fxb));
+  const cv::v_uint16x8 gx = cv::v_setall_u16(kInterTabSize) - fx;
   // Horizontal step, exact in 16 bits (<= 255 * 32).
-  const v_uint16x8 ht = v_mul_wrap(T & lo8, gx) + v_mul_wrap(v_shr<8>(T), fx);
-  const v_uint16x8 hb = v_mul_wrap(B & lo8, gx) + v_mul_wrap(v_shr<8>(B), fx);
-  v_int16x8 z0, z1;
-  v_zip(v_reinterpret_as_s16(ht), v_reinterpret_as_s16(hb), z0, z1);
-  const v_int32x4 wya = (k32 - fya) | v_shl<16>(fya);
-  const v_int32x4 wyb = (k32 - fyb) | v_shl<16>(fyb);
-  const v_int16x8 r =
-      v_rshr_pack<kWeightShift>(Vertical(z0, wya), Vertical(z1, wyb));
-  v_pack_u_store(out, r);
+  const cv::v_uint16x8 ht =
+      cv::v_mul_wrap(T & lo8, gx) + cv::v_mul_wrap(cv::v_shr<8>(T), fx);
+  const cv::v_uint16x8 hb =
+      cv::v_mul_wrap(B & lo8, gx) + cv::v_mul_wrap(cv::v_shr<8>(B), fx);
+  cv::v_int16x8 z0, z1;
+  cv::v_zip(cv::v_reinterpret_as_s16(ht), cv::v_reinterpret_as_s16(hb), z0, z1);
+  const cv::v_int32x4 wya = (k32 - fya) | cv::v_shl<16>(fya);
+  const cv::v_int32x4 wyb = (k32 - fyb) | cv::v_shl<16>(fyb);
+  const cv::v_int16x8 r =
+      cv::v_rshr_pack<kWeightShift>(Vertical(z0, wya), Vertical(z1, wyb));
+  cv::v_pack_u_store(out, r);
 }
 
 // 3 or 4 channels: 4 pixels of a stepped segment. `wide`: 3 channels may
@@ -139,12 +141,11 @@ inline void Mono8(const uchar* base, size_t step, const cv::v_int32x4& Xa,
 template <int CN>
 inline void Color4(const uchar* base, size_t step, const cv::v_int32x4& X,
                    const cv::v_int32x4& Y, bool wide, uchar* out) {
-  using namespace cv;
-  const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
-  const v_int32x4 k32 = v_setall_s32(kInterTabSize);
+  const cv::v_int32x4 m31 = cv::v_setall_s32(kInterTabSize - 1);
+  const cv::v_int32x4 k32 = cv::v_setall_s32(kInterTabSize);
   int ix[4], iy[4];
-  v_store(ix, v_shr<kScanFrac + kInterBits>(X));
-  v_store(iy, v_shr<kScanFrac + kInterBits>(Y));
+  cv::v_store(ix, cv::v_shr<kScanFrac + kInterBits>(X));
+  cv::v_store(iy, cv::v_shr<kScanFrac + kInterBits>(Y));
   // One 8-byte read per pixel and row holds both columns: 4 bytes at the
   // pixel (BGR + the next byte, or BGRA) and, CN bytes on, 4 at its right
   // neighbour. Vectors are built from registers (no store-to-load trip).
@@ -156,54 +157,57 @@ inline void Color4(const uchar* base, size_t step, const cv::v_int32x4& X,
   }
   auto lo = [](uint64_t v) { return static_cast<unsigned>(v); };
   auto hi = [](uint64_t v) { return static_cast<unsigned>(v >> (8 * CN)); };
-  v_uint16x8 a0, a1, b0, b1, c0, c1, d0, d1;  // [pixel 0 | pixel 1], [2 | 3]
-  v_expand(
-      v_reinterpret_as_u8(v_uint32x4(lo(t[0]), lo(t[1]), lo(t[2]), lo(t[3]))),
-      a0, a1);
-  v_expand(
-      v_reinterpret_as_u8(v_uint32x4(hi(t[0]), hi(t[1]), hi(t[2]), hi(t[3]))),
-      b0, b1);
-  v_expand(
-      v_reinterpret_as_u8(v_uint32x4(lo(b[0]), lo(b[1]), lo(b[2]), lo(b[3]))),
-      c0, c1);
-  v_expand(
-      v_reinterpret_as_u8(v_uint32x4(hi(b[0]), hi(b[1]), hi(b[2]), hi(b[3]))),
-      d0, d1);
+  cv::v_uint16x8 a0, a1, b0, b1, c0, c1, d0,
+      d1;  // [pixel 0 | pixel 1], [2 | 3]
+  cv::v_expand(cv::v_reinterpret_as_u8(
+                   cv::v_uint32x4(lo(t[0]), lo(t[1]), lo(t[2]), lo(t[3]))),
+               a0, a1);
+  cv::v_expand(cv::v_reinterpret_as_u8(
+                   cv::v_uint32x4(hi(t[0]), hi(t[1]), hi(t[2]), hi(t[3]))),
+               b0, b1);
+  cv::v_expand(cv::v_reinterpret_as_u8(
+                   cv::v_uint32x4(lo(b[0]), lo(b[1]), lo(b[2]), lo(b[3]))),
+               c0, c1);
+  cv::v_expand(cv::v_reinterpret_as_u8(
+                   cv::v_uint32x4(hi(b[0]), hi(b[1]), hi(b[2]), hi(b[3]))),
+               d0, d1);
   // fx of each pixel in all 4 of its 16-bit lanes.
-  const v_int32x4 fx = v_shr<kScanFrac>(X) & m31;
-  const v_uint32x4 fx2 = v_reinterpret_as_u32(fx | v_shl<16>(fx));
-  v_uint32x4 f01, f23;
-  v_zip(fx2, fx2, f01, f23);
-  const v_uint16x8 fx0 = v_reinterpret_as_u16(f01),
-                   fx1 = v_reinterpret_as_u16(f23);
-  const v_uint16x8 gx0 = v_setall_u16(kInterTabSize) - fx0;
-  const v_uint16x8 gx1 = v_setall_u16(kInterTabSize) - fx1;
+  const cv::v_int32x4 fx = cv::v_shr<kScanFrac>(X) & m31;
+  const cv::v_uint32x4 fx2 = cv::v_reinterpret_as_u32(fx | cv::v_shl<16>(fx));
+  cv::v_uint32x4 f01, f23;
+  cv::v_zip(fx2, fx2, f01, f23);
+  const cv::v_uint16x8 fx0 = cv::v_reinterpret_as_u16(f01),
+                       fx1 = cv::v_reinterpret_as_u16(f23);
+  const cv::v_uint16x8 gx0 = cv::v_setall_u16(kInterTabSize) - fx0;
+  const cv::v_uint16x8 gx1 = cv::v_setall_u16(kInterTabSize) - fx1;
   // Horizontal step, exact in 16 bits (<= 255 * 32).
-  const v_uint16x8 ht0 = v_mul_wrap(a0, gx0) + v_mul_wrap(b0, fx0);
-  const v_uint16x8 ht1 = v_mul_wrap(a1, gx1) + v_mul_wrap(b1, fx1);
-  const v_uint16x8 hb0 = v_mul_wrap(c0, gx0) + v_mul_wrap(d0, fx0);
-  const v_uint16x8 hb1 = v_mul_wrap(c1, gx1) + v_mul_wrap(d1, fx1);
-  v_int16x8 p0, p1, p2, p3;  // per pixel: (top, bottom) per channel
-  v_zip(v_reinterpret_as_s16(ht0), v_reinterpret_as_s16(hb0), p0, p1);
-  v_zip(v_reinterpret_as_s16(ht1), v_reinterpret_as_s16(hb1), p2, p3);
-  const v_int32x4 fy = v_shr<kScanFrac>(Y) & m31;
-  const v_int32x4 wy = (k32 - fy) | v_shl<16>(fy);
-  const v_int16x8 r01 =
-      v_rshr_pack<kWeightShift>(Vertical(p0, v_broadcast_element<0>(wy)),
-                                Vertical(p1, v_broadcast_element<1>(wy)));
-  const v_int16x8 r23 =
-      v_rshr_pack<kWeightShift>(Vertical(p2, v_broadcast_element<2>(wy)),
-                                Vertical(p3, v_broadcast_element<3>(wy)));
-  const v_uint8x16 r = v_pack_u(r01, r23);
+  const cv::v_uint16x8 ht0 = cv::v_mul_wrap(a0, gx0) + cv::v_mul_wrap(b0, fx0);
+  const cv::v_uint16x8 ht1 = cv::v_mul_wrap(a1, gx1) + cv::v_mul_wrap(b1, fx1);
+  const cv::v_uint16x8 hb0 = cv::v_mul_wrap(c0, gx0) + cv::v_mul_wrap(d0, fx0);
+  const cv::v_uint16x8 hb1 = cv::v_mul_wrap(c1, gx1) + cv::v_mul_wrap(d1, fx1);
+  cv::v_int16x8 p0, p1, p2, p3;  // per pixel: (top, bottom) per channel
+  cv::v_zip(cv::v_reinterpret_as_s16(ht0), cv::v_reinterpret_as_s16(hb0), p0,
+            p1);
+  cv::v_zip(cv::v_reinterpret_as_s16(ht1), cv::v_reinterpret_as_s16(hb1), p2,
+            p3);
+  const cv::v_int32x4 fy = cv::v_shr<kScanFrac>(Y) & m31;
+  const cv::v_int32x4 wy = (k32 - fy) | cv::v_shl<16>(fy);
+  const cv::v_int16x8 r01 = cv::v_rshr_pack<kWeightShift>(
+      Vertical(p0, cv::v_broadcast_element<0>(wy)),
+      Vertical(p1, cv::v_broadcast_element<1>(wy)));
+  const cv::v_int16x8 r23 = cv::v_rshr_pack<kWeightShift>(
+      Vertical(p2, cv::v_broadcast_element<2>(wy)),
+      Vertical(p3, cv::v_broadcast_element<3>(wy)));
+  const cv::v_uint8x16 r = cv::v_pack_u(r01, r23);
   if (CN == 4) {
-    v_store(out, r);
+    cv::v_store(out, r);
   } else if (wide) {
-    v_store(out, v_pack_triplets(r));
+    cv::v_store(out, cv::v_pack_triplets(r));
   } else {
     // 12 bytes, straight from the register (no round trip through memory).
-    const v_uint8x16 packed = v_pack_triplets(r);
-    v_store_low(out, packed);
-    const unsigned tail = v_extract_n<2>(v_reinterpret_as_u32(packed));
+    const cv::v_uint8x16 packed = cv::v_pack_triplets(r);
+    cv::v_store_low(out, packed);
+    const unsigned tail = cv::v_extract_n<2>(cv::v_reinterpret_as_u32(packed));
     std::memcpy(out + 8, &tail, 4);
   }
 }
