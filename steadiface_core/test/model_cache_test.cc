@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +20,7 @@
 
 #include "steadiface_core/face/face_detector.h"
 #include "steadiface_core/face/landmark_predictor.h"
+#include "steadiface_core/face/landmark_predictor_impl.h"
 #include "steadiface_core/model_cache.h"
 #include "test_util.h"
 
@@ -150,6 +152,88 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
     ASSERT_TRUE(p->Predict(grey, box, &again).ok());
     ASSERT_EQ(again.size(), reference.size());
     EXPECT_EQ(again[30].x(), reference[30].x());
+  }
+  // A split index past the cascade's features (Predict would read out of
+  // bounds with it): refused, decoded again, rewritten.
+  {
+    std::FILE* f = std::fopen(files[0].c_str(), "r+b");
+    ASSERT_NE(f, nullptr);
+    uint64_t len = 0;
+    ASSERT_EQ(std::fseek(f, 24, SEEK_SET), 0);
+    ASSERT_EQ(std::fread(&len, sizeof(len), 1, f), 1u);
+    // Header, shape, then the counts: cascades, trees, splits and leaves
+    // per tree; then per cascade its 500 anchors and 500 deltas (each with
+    // its count), then the split count and the first split's idx1.
+    const long counts = static_cast<long>(32 + len + 8 + 136 * 4);
+    uint64_t c[4] = {0, 0, 0, 0};
+    ASSERT_EQ(std::fseek(f, counts, SEEK_SET), 0);
+    ASSERT_EQ(std::fread(c, sizeof(uint64_t), 4, f), 4u);
+    EXPECT_EQ(c[0], 15u);
+    EXPECT_EQ(c[1], 500u);
+    EXPECT_EQ(c[2], 15u);
+    EXPECT_EQ(c[3], 16u);
+    const long first_split = counts + 32 + 15 * (8 + 500 * 8 + 8 + 500 * 8) + 8;
+    uint32_t idx1 = 0;
+    ASSERT_EQ(std::fseek(f, first_split, SEEK_SET), 0);
+    ASSERT_EQ(std::fread(&idx1, sizeof(idx1), 1, f), 1u);
+    EXPECT_LT(idx1, 500u);
+    const uint32_t damaged = 500;
+    ASSERT_EQ(std::fseek(f, first_split, SEEK_SET), 0);
+    ASSERT_EQ(std::fwrite(&damaged, sizeof(damaged), 1, f), 1u);
+    std::fclose(f);
+    std::unique_ptr<LandmarkPredictor> p;
+    ASSERT_TRUE(
+        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+    EXPECT_FALSE(p->loaded_from_cache());
+    p.reset();  // else the process's memo hands the same model back
+    std::unique_ptr<LandmarkPredictor> again;
+    ASSERT_TRUE(
+        LandmarkPredictor::Load(kDefaultShapePredictorPath, &again, dir).ok());
+    EXPECT_TRUE(again->loaded_packed_from_cache());
+  }
+  // A cache in the plain form (dlib's structures, as older versions wrote
+  // it): read, packed, and rewritten in the packed form for the next run.
+  {
+    LandmarkModelKey key;
+    ASSERT_TRUE(StatLandmarkModel(kDefaultShapePredictorPath, &key));
+    {
+      LandmarkPredictor::Impl m;
+      std::ifstream in(kDefaultShapePredictorPath, std::ios::binary);
+      int version = 0;
+      dlib::deserialize(version, in);
+      dlib::deserialize(m.initial_shape, in);
+      dlib::deserialize(m.forests, in);
+      dlib::deserialize(m.anchor_idx, in);
+      dlib::deserialize(m.deltas, in);
+      m.WriteCache(dir, files[0], key);
+    }
+    std::string bytes;
+    ASSERT_TRUE(ReadWholeFile(files[0], &bytes));
+    EXPECT_EQ(bytes.substr(0, 8), "SFLMCAC1");
+    std::vector<Eigen::Vector2d> plain, repacked;
+    {
+      std::unique_ptr<LandmarkPredictor> p;
+      ASSERT_TRUE(
+          LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+      EXPECT_TRUE(p->loaded_from_cache());
+      EXPECT_FALSE(p->loaded_packed_from_cache());
+      ASSERT_TRUE(p->Predict(grey, box, &plain).ok());
+    }
+    ASSERT_TRUE(ReadWholeFile(files[0], &bytes));
+    EXPECT_EQ(bytes.substr(0, 8), "SFLMPAK2");
+    {
+      std::unique_ptr<LandmarkPredictor> p;
+      ASSERT_TRUE(
+          LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+      EXPECT_TRUE(p->loaded_packed_from_cache());
+      ASSERT_TRUE(p->Predict(grey, box, &repacked).ok());
+    }
+    ASSERT_EQ(plain.size(), reference.size());
+    ASSERT_EQ(repacked.size(), reference.size());
+    for (size_t i = 0; i < reference.size(); ++i) {
+      EXPECT_EQ(plain[i], reference[i]) << i;
+      EXPECT_EQ(repacked[i], reference[i]) << i;
+    }
   }
   // An unwritable cache directory is not an error.
   {

@@ -41,8 +41,13 @@ std::string LandmarkCacheFile(const std::string& dir,
 namespace {
 
 // The decoded-model cache: plain native-endian arrays behind a header that
-// names the source (canonical path, size, modification time).
+// names the source (canonical path, size, modification time). The plain
+// form (dlib's structures) and the packed form (Impl's) differ in magic.
 constexpr char kCacheMagic[8] = {'S', 'F', 'L', 'M', 'C', 'A', 'C', '1'};
+constexpr char kPackedMagic[8] = {'S', 'F', 'L', 'M', 'P', 'A', 'K', '2'};
+// The packed form's leaf block starts at a multiple of this in the file, so
+// the mapped leaves are page- (and so cache-line-) aligned.
+constexpr uint64_t kLeafAlignment = 4096;
 
 class CacheWriter {
  public:
@@ -89,6 +94,7 @@ class CacheReader {
     return true;
   }
   bool AtEnd() const { return p_ == end_; }
+  size_t left() const { return static_cast<size_t>(end_ - p_); }
 
  private:
   const char* p_;
@@ -96,7 +102,8 @@ class CacheReader {
 };
 
 // The header: magic and the model file the cache was decoded from.
-bool ReadCacheHeader(CacheReader* r, const LandmarkModelKey& key) {
+bool ReadCacheHeader(CacheReader* r, const LandmarkModelKey& key,
+                     const char (&expected)[8] = kCacheMagic) {
   char magic[8];
   uint64_t size = 0, len = 0;
   int64_t mtime = 0;
@@ -104,7 +111,7 @@ bool ReadCacheHeader(CacheReader* r, const LandmarkModelKey& key) {
   for (char& c : magic) {
     if (!r->Pod(&c)) return false;
   }
-  return std::memcmp(magic, kCacheMagic, sizeof(magic)) == 0 && r->Pod(&size) &&
+  return std::memcmp(magic, expected, sizeof(magic)) == 0 && r->Pod(&size) &&
          r->Pod(&mtime) && r->Count(&len, 1) && r->Bytes(&canonical, len) &&
          size == key.size && mtime == key.mtime_ns &&
          canonical == key.canonical;
@@ -141,16 +148,40 @@ bool ReadAnchorsAndDeltas(CacheReader* r, std::vector<unsigned long>* anchors,
 }
 
 // The closing magic, and nothing after it.
-bool ReadCacheTrailer(CacheReader* r) {
+bool ReadCacheTrailer(CacheReader* r, const char (&expected)[8] = kCacheMagic) {
   char magic[8];
   for (char& c : magic) {
     if (!r->Pod(&c)) return false;
   }
-  return std::memcmp(magic, kCacheMagic, sizeof(magic)) == 0 && r->AtEnd();
+  return std::memcmp(magic, expected, sizeof(magic)) == 0 && r->AtEnd();
 }
 
-// The cache file mapped read-only (no copy into a buffer); unmapped when it
-// goes out of scope.
+// The header both forms share: magic, the model file's key.
+void WriteCacheHeader(CacheWriter* w, std::ostream* out,
+                      const LandmarkModelKey& key, const char (&magic)[8]) {
+  for (char c : magic) w->Pod(c);
+  w->Pod(key.size);
+  w->Pod(key.mtime_ns);
+  w->Pod(static_cast<uint64_t>(key.canonical.size()));
+  out->write(key.canonical.data(),
+             static_cast<std::streamsize>(key.canonical.size()));
+}
+
+// One cascade's feature anchors and deltas, as ReadAnchorsAndDeltas reads.
+void WriteAnchorsAndDeltas(CacheWriter* w,
+                           const std::vector<unsigned long>& anchors,
+                           const std::vector<dlib::vector<float, 2>>& deltas) {
+  w->Pod(static_cast<uint64_t>(anchors.size()));
+  for (unsigned long a : anchors) w->Pod(static_cast<uint64_t>(a));
+  w->Pod(static_cast<uint64_t>(deltas.size()));
+  for (const auto& d : deltas) {
+    w->Pod(d.x());
+    w->Pod(d.y());
+  }
+}
+
+// The cache file mapped read-only (no copy into a buffer, and no page
+// touched until read); unmapped when it goes out of scope unless released.
 class MappedFile {
  public:
   explicit MappedFile(const std::string& path) {
@@ -159,7 +190,7 @@ class MappedFile {
     struct stat st;
     if (fstat(fd, &st) == 0 && st.st_size > 0) {
       void* p = mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ,
-                     MAP_PRIVATE | MAP_POPULATE, fd, 0);
+                     MAP_PRIVATE, fd, 0);
       if (p != MAP_FAILED) {
         data_ = static_cast<const char*>(p);
         size_ = static_cast<size_t>(st.st_size);
@@ -174,6 +205,8 @@ class MappedFile {
   MappedFile& operator=(const MappedFile&) = delete;
   const char* data() const { return data_; }
   size_t size() const { return size_; }
+  // Hands the mapping over: the caller unmaps it (data(), size()).
+  void Release() { data_ = nullptr; }
 
  private:
   const char* data_ = nullptr;
@@ -182,89 +215,84 @@ class MappedFile {
 
 }  // namespace
 
-// The cache read straight into the packed layout (Impl::Pack's): splits
-// into their records and each leaf copied once into the leaf block, from
-// the mapped file. No dlib tree objects, so none of their ~80 000 small
-// allocations, copies and frees (this was ~0.9 s of every process start).
-// False, with this Impl to be discarded, when the file is not this model's, is
-// damaged (every count is checked against the bytes left, as in the dlib
-// path), or holds trees that are not all alike (the caller then takes the
-// dlib-structure path, which walks such trees as they are).
+// The packed form, mapped: the splits copied into their records (2.8 MB for
+// the 68-point model), the leaf block left where it is in the mapping (see
+// Impl). False, with this Impl to be discarded, when the file is not this
+// model's or not packed, or is damaged: every count is checked against the
+// bytes left, the leaf block must end exactly at the trailer, and every
+// split and anchor index must be in range (Predict indexes with them
+// unchecked).
 bool LandmarkPredictor::Impl::ReadPackedCache(const std::string& file,
                                               const LandmarkModelKey& key) {
   Impl* m = this;
-  const MappedFile mapped(file);
+  MappedFile mapped(file);
   if (mapped.data() == nullptr) return false;
   CacheReader r(mapped.data(), mapped.size());
-  uint64_t n_cascades = 0;
-  if (!ReadCacheHeader(&r, key) ||
+  uint64_t n_cascades = 0, trees = 0, splits_per_tree = 0, leaves_per_tree = 0;
+  if (!ReadCacheHeader(&r, key, kPackedMagic) ||
       !ReadShapeAndCascades(&r, &m->initial_shape, &n_cascades) ||
-      n_cascades == 0) {
+      n_cascades == 0 || !r.Count(&trees, 16) || trees == 0 ||
+      !r.Count(&splits_per_tree, 12) || !r.Pod(&leaves_per_tree) ||
+      leaves_per_tree != splits_per_tree + 1) {
     return false;
   }
   const uint64_t n = static_cast<uint64_t>(m->initial_shape.size());
-  float* dst = nullptr;
+  const uint64_t parts = n / 2;
+  m->forests.resize(n_cascades);  // their count only: the trees are packed
+  m->anchor_idx.resize(n_cascades);
+  m->deltas.resize(n_cascades);
   for (uint64_t c = 0; c < n_cascades; ++c) {
-    uint64_t n_trees = 0;
-    if (!r.Count(&n_trees, 16) || n_trees == 0) return false;
-    if (c == 0) {
-      m->trees = n_trees;
-    } else if (n_trees != m->trees) {
+    if (!ReadAnchorsAndDeltas(&r, &m->anchor_idx[c], &m->deltas[c]) ||
+        m->anchor_idx[c].size() != m->deltas[c].size()) {
       return false;
     }
-    for (uint64_t t = 0; t < n_trees; ++t) {
-      uint64_t n_splits = 0, n_leaves = 0;
-      if (!r.Count(&n_splits, 20)) return false;
-      const bool first = c == 0 && t == 0;
-      if (first) {
-        m->splits_per_tree = n_splits;
-      } else if (n_splits != m->splits_per_tree) {
-        return false;
-      }
-      for (uint64_t i = 0; i < n_splits; ++i) {
-        uint64_t a = 0, b = 0;
-        float thresh = 0.0f;
-        if (!r.Pod(&a) || !r.Pod(&b) || !r.Pod(&thresh) || a > UINT32_MAX ||
-            b > UINT32_MAX) {
-          return false;
-        }
-        m->splits.push_back(
-            Split{static_cast<uint32_t>(a), static_cast<uint32_t>(b), thresh});
-      }
-      if (!r.Count(&n_leaves, 8)) return false;
-      if (first) {
-        if (n_leaves != n_splits + 1) return false;
-        m->leaves_per_tree = n_leaves;
-        // Every leaf must be in the file: checked before allocating.
-        const uint64_t floats = n_cascades * n_trees * n_leaves * n;
-        if (floats / n / n_leaves / n_trees != n_cascades ||
-            floats > mapped.size() / sizeof(float)) {
-          return false;
-        }
-        if (!m->AllocateLeaves(static_cast<size_t>(floats))) return false;
-        dst = m->leaves;
-        // Sized only now: the leaf block's check above bounds every count
-        // (a damaged cache cannot ask for more than its own size).
-        m->splits.reserve(n_cascades * n_trees * n_splits);
-        m->forests.resize(n_cascades);  // their count only: trees are packed
-        m->anchor_idx.resize(n_cascades);
-        m->deltas.resize(n_cascades);
-      } else if (n_leaves != m->leaves_per_tree) {
-        return false;
-      }
-      for (uint64_t l = 0; l < n_leaves; ++l) {
-        uint64_t k = 0;
-        if (!r.Count(&k, sizeof(float)) || k != n || !r.Floats(dst, n)) {
-          return false;
-        }
-        dst += n;
-      }
-    }
-    if (!ReadAnchorsAndDeltas(&r, &m->anchor_idx[c], &m->deltas[c])) {
-      return false;
+    for (unsigned long a : m->anchor_idx[c]) {
+      if (a >= parts) return false;
     }
   }
-  return ReadCacheTrailer(&r);
+  uint64_t n_splits = 0;
+  if (!r.Count(&n_splits, 12) ||
+      n_splits / n_cascades / trees != splits_per_tree ||
+      n_splits != n_cascades * trees * splits_per_tree) {
+    return false;
+  }
+  m->splits.resize(n_splits);
+  for (uint64_t c = 0, i = 0; c < n_cascades; ++c) {
+    const uint64_t features = m->anchor_idx[c].size();
+    for (uint64_t k = 0; k < trees * splits_per_tree; ++k, ++i) {
+      Split& sp = m->splits[i];
+      if (!r.Pod(&sp.idx1) || !r.Pod(&sp.idx2) || !r.Pod(&sp.thresh) ||
+          sp.idx1 >= features || sp.idx2 >= features) {
+        return false;
+      }
+    }
+  }
+  // The leaf block: at its page-aligned offset, filling the file up to the
+  // trailer exactly.
+  uint64_t offset = 0;
+  if (!r.Pod(&offset) || offset % kLeafAlignment != 0 ||
+      offset < mapped.size() - r.left() || offset > mapped.size()) {
+    return false;
+  }
+  const uint64_t floats = n_cascades * trees * leaves_per_tree * n;
+  const uint64_t block = mapped.size() - offset;
+  if (floats / n / leaves_per_tree / trees != n_cascades ||
+      block < sizeof(kPackedMagic) ||
+      (block - sizeof(kPackedMagic)) / sizeof(float) != floats ||
+      (block - sizeof(kPackedMagic)) % sizeof(float) != 0) {
+    return false;
+  }
+  CacheReader trailer(mapped.data() + offset + floats * sizeof(float),
+                      sizeof(kPackedMagic));
+  if (!ReadCacheTrailer(&trailer, kPackedMagic)) return false;
+  m->trees = trees;
+  m->splits_per_tree = splits_per_tree;
+  m->leaves_per_tree = leaves_per_tree;
+  m->leaves = reinterpret_cast<const float*>(mapped.data() + offset);
+  m->mapping = const_cast<char*>(mapped.data());
+  m->mapping_bytes = mapped.size();
+  mapped.Release();
+  return true;
 }
 
 // The cache read into dlib's structures (for a model whose trees are not
@@ -313,51 +341,75 @@ bool LandmarkPredictor::Impl::ReadCache(const std::string& file,
   return ReadCacheTrailer(&r);
 }
 
-// Writes the cache next to nothing else: a temporary file renamed into
-// place, so a reader never sees half a file. Failure is silent.
+// Writes the plain form: a temporary file renamed into place, so a reader
+// never sees half a file. Failure is silent.
 void LandmarkPredictor::Impl::WriteCache(const std::string& dir,
                                          const std::string& file,
                                          const LandmarkModelKey& key) const {
   const Impl& m = *this;
   if (!MakeCacheDirs(dir)) return;
-  {
-    std::ostringstream out;
-    CacheWriter w(&out);
-    for (char c : kCacheMagic) w.Pod(c);
-    w.Pod(key.size);
-    w.Pod(key.mtime_ns);
-    w.Pod(static_cast<uint64_t>(key.canonical.size()));
-    out.write(key.canonical.data(),
-              static_cast<std::streamsize>(key.canonical.size()));
-    w.Floats(&m.initial_shape(0),
-             static_cast<uint64_t>(m.initial_shape.size()));
-    w.Pod(static_cast<uint64_t>(m.forests.size()));
-    for (size_t c = 0; c < m.forests.size(); ++c) {
-      w.Pod(static_cast<uint64_t>(m.forests[c].size()));
-      for (const auto& tree : m.forests[c]) {
-        w.Pod(static_cast<uint64_t>(tree.splits.size()));
-        for (const auto& s : tree.splits) {
-          w.Pod(static_cast<uint64_t>(s.idx1));
-          w.Pod(static_cast<uint64_t>(s.idx2));
-          w.Pod(s.thresh);
-        }
-        w.Pod(static_cast<uint64_t>(tree.leaf_values.size()));
-        for (const auto& leaf : tree.leaf_values) {
-          w.Floats(leaf.size() > 0 ? &leaf(0) : nullptr,
-                   static_cast<uint64_t>(leaf.size()));
-        }
+  std::ostringstream out;
+  CacheWriter w(&out);
+  WriteCacheHeader(&w, &out, key, kCacheMagic);
+  w.Floats(&m.initial_shape(0), static_cast<uint64_t>(m.initial_shape.size()));
+  w.Pod(static_cast<uint64_t>(m.forests.size()));
+  for (size_t c = 0; c < m.forests.size(); ++c) {
+    w.Pod(static_cast<uint64_t>(m.forests[c].size()));
+    for (const auto& tree : m.forests[c]) {
+      w.Pod(static_cast<uint64_t>(tree.splits.size()));
+      for (const auto& s : tree.splits) {
+        w.Pod(static_cast<uint64_t>(s.idx1));
+        w.Pod(static_cast<uint64_t>(s.idx2));
+        w.Pod(s.thresh);
       }
-      w.Pod(static_cast<uint64_t>(m.anchor_idx[c].size()));
-      for (unsigned long a : m.anchor_idx[c]) w.Pod(static_cast<uint64_t>(a));
-      w.Pod(static_cast<uint64_t>(m.deltas[c].size()));
-      for (const auto& d : m.deltas[c]) {
-        w.Pod(d.x());
-        w.Pod(d.y());
+      w.Pod(static_cast<uint64_t>(tree.leaf_values.size()));
+      for (const auto& leaf : tree.leaf_values) {
+        w.Floats(leaf.size() > 0 ? &leaf(0) : nullptr,
+                 static_cast<uint64_t>(leaf.size()));
       }
     }
-    for (char c : kCacheMagic) w.Pod(c);
-    WriteFileAtomically(file, out.str());
+    WriteAnchorsAndDeltas(&w, m.anchor_idx[c], m.deltas[c]);
   }
+  for (char c : kCacheMagic) w.Pod(c);
+  WriteFileAtomically(file, out.str());
+}
+
+// Writes the packed form (ReadPackedCache's layout) of a packed model, the
+// same way. Failure is silent.
+void LandmarkPredictor::Impl::WritePackedCache(
+    const std::string& dir, const std::string& file,
+    const LandmarkModelKey& key) const {
+  const Impl& m = *this;
+  if (!m.packed() || !MakeCacheDirs(dir)) return;
+  std::ostringstream out;
+  CacheWriter w(&out);
+  WriteCacheHeader(&w, &out, key, kPackedMagic);
+  const uint64_t n = static_cast<uint64_t>(m.initial_shape.size());
+  w.Floats(&m.initial_shape(0), n);
+  w.Pod(static_cast<uint64_t>(m.forests.size()));
+  w.Pod(static_cast<uint64_t>(m.trees));
+  w.Pod(static_cast<uint64_t>(m.splits_per_tree));
+  w.Pod(static_cast<uint64_t>(m.leaves_per_tree));
+  for (size_t c = 0; c < m.forests.size(); ++c) {
+    WriteAnchorsAndDeltas(&w, m.anchor_idx[c], m.deltas[c]);
+  }
+  w.Pod(static_cast<uint64_t>(m.splits.size()));
+  for (const Split& s : m.splits) {
+    w.Pod(s.idx1);
+    w.Pod(s.idx2);
+    w.Pod(s.thresh);
+  }
+  const uint64_t here = static_cast<uint64_t>(out.tellp()) + sizeof(uint64_t);
+  const uint64_t offset =
+      (here + kLeafAlignment - 1) / kLeafAlignment * kLeafAlignment;
+  w.Pod(offset);
+  const std::string pad(offset - here, '\0');
+  out.write(pad.data(), static_cast<std::streamsize>(pad.size()));
+  const uint64_t floats = m.forests.size() * m.trees * m.leaves_per_tree * n;
+  out.write(reinterpret_cast<const char*>(m.leaves),
+            static_cast<std::streamsize>(floats * sizeof(float)));
+  for (char c : kPackedMagic) w.Pod(c);
+  WriteFileAtomically(file, out.str());
 }
 
 }  // namespace steadiface

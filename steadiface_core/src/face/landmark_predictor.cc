@@ -43,7 +43,7 @@ void LandmarkPredictor::Impl::Pack() {
   }
   if (!AllocateLeaves(forests.size() * trees * leaves_per_tree * n)) return;
   splits.reserve(forests.size() * trees * splits_per_tree);
-  float* dst = leaves;
+  float* dst = owned_leaves;
   for (auto& forest : forests) {
     for (auto& tree : forest) {
       for (const auto& sp : tree.splits) {
@@ -123,13 +123,16 @@ Status LandmarkPredictor::Load(const std::string& path,
       impl->forests.size() == impl->deltas.size()) {
     return finish(impl, true, true);
   }
-  // Not packable straight from the cache (or no cache): dlib's structures.
+  // No packed cache (a plain one, a damaged one, or none): dlib's structures.
   impl = std::make_shared<Impl>();
   if (cacheable && impl->ReadCache(cache_file, key) &&
       impl->num_parts() == 68 && !impl->forests.empty() &&
       impl->forests.size() == impl->anchor_idx.size() &&
       impl->forests.size() == impl->deltas.size()) {
     impl->Pack();
+    // A plain cache of a packable model (as older versions wrote): packed
+    // from now on.
+    if (impl->packed()) impl->WritePackedCache(cache_dir, cache_file, key);
     return finish(impl, true, false);
   }
   impl = std::make_shared<Impl>();
@@ -160,8 +163,12 @@ Status LandmarkPredictor::Load(const std::string& path,
                          std::to_string(impl->num_parts()) +
                          " points; steadiface needs the 68-point model" + hint);
   }
-  if (cacheable) impl->WriteCache(cache_dir, cache_file, key);
   impl->Pack();
+  if (cacheable && impl->packed()) {
+    impl->WritePackedCache(cache_dir, cache_file, key);
+  } else if (cacheable) {
+    impl->WriteCache(cache_dir, cache_file, key);  // Pack() left dlib's trees
+  }
   return finish(impl, false, false);
 }
 

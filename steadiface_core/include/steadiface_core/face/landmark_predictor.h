@@ -30,7 +30,9 @@ class LandmarkPredictor {
   /// ~0.5 s to decode (the 68-point model: 100 MB). The decoded model is
   /// kept in `cache_dir` (created if needed; "" = no cache) as plain
   /// arrays, keyed by the model's path, size and modification time, and
-  /// read from there next time (~10x faster, the same floats). A missing,
+  /// read from there next time (the same floats; the leaves, most of it,
+  /// are mapped from the file rather than read, so a run pages in only
+  /// those its fits reach; the file is only ever replaced whole). A missing,
   /// stale, foreign or damaged cache file is ignored and rewritten
   /// (atomically); a cache that cannot be written is not an error.
   static Status Load(const std::string& path,
@@ -55,9 +57,12 @@ class LandmarkPredictor {
   /// coordinates of dlib ([0, 1] x [0, 1] over the detector box).
   std::vector<Eigen::Vector2d> MeanShape() const;
 
+  /// The model (landmark_predictor_impl.h): internal, named here for the
+  /// cache's tests.
+  struct Impl;
+
  private:
   LandmarkPredictor();
-  struct Impl;
   std::shared_ptr<const Impl> impl_;
   bool from_cache_ = false;
   bool packed_from_cache_ = false;

@@ -54,37 +54,56 @@ struct LandmarkPredictor::Impl {
   // Cascade c, tree t: its splits from (c * trees + t) * splits_per_tree,
   // its leaf l at ((c * trees + t) * leaves_per_tree + l) * n floats.
   std::vector<Split> splits;
-  float* leaves = nullptr;
+  // The leaf block: either owned (owned_leaves, from Pack()) or the packed
+  // cache file's own pages, mapped read-only (mapping; see ReadPackedCache).
+  const float* leaves = nullptr;
   size_t trees = 0, splits_per_tree = 0, leaves_per_tree = 0;
   bool packed() const { return leaves != nullptr; }
   void Pack();
-  // The decoded-model cache (landmark_model_cache.cc): a file of plain
-  // native-endian arrays, named after the model file it was decoded from.
-  // Read straight into the packed trees (the fast load; false when the file
-  // is not this model's, is damaged, or its trees are not all alike), read
-  // into dlib's structures, or written (atomically; failure is silent).
+  // The decoded-model cache (landmark_model_cache.cc), named after the
+  // model file it was decoded from, in one of two forms:
+  //  - packed (models whose trees are all alike, as dlib's shipped ones):
+  //    the packed splits, then the leaf block page-aligned in the file, so
+  //    that ReadPackedCache maps it instead of reading it: a run faults in
+  //    only the pages of the leaves its fits reach, from the page cache,
+  //    where a copy cost ~0.1 CPU-s of zeroed huge pages and memcpy;
+  //  - plain (any other model): dlib's structures as native-endian arrays,
+  //    read by ReadCache.
+  // The readers return false when the file is not this model's, is damaged
+  // or is of the other form; the writers write atomically and fail silently.
   bool ReadPackedCache(const std::string& file, const LandmarkModelKey& key);
   bool ReadCache(const std::string& file, const LandmarkModelKey& key);
+  void WritePackedCache(const std::string& dir, const std::string& file,
+                        const LandmarkModelKey& key) const;
   void WriteCache(const std::string& dir, const std::string& file,
                   const LandmarkModelKey& key) const;
-  // The leaf block for `floats` floats: aligned and padded to 2 MiB and
-  // advised onto transparent huge pages, so filling it takes a few dozen
-  // page faults instead of ~17 000 (each costly in a VM). False if it
+  // The owned leaf block for `floats` floats: aligned and padded to 2 MiB
+  // and advised onto transparent huge pages, so filling it takes a few
+  // dozen page faults instead of ~17 000 (each costly in a VM). False if it
   // cannot be had.
   bool AllocateLeaves(size_t floats) {
     constexpr size_t kHuge = size_t{2} << 20;
     const size_t bytes = (floats * sizeof(float) + kHuge - 1) / kHuge * kHuge;
-    leaves = static_cast<float*>(std::aligned_alloc(kHuge, bytes));
-    if (leaves == nullptr) return false;
+    owned_leaves = static_cast<float*>(std::aligned_alloc(kHuge, bytes));
+    if (owned_leaves == nullptr) return false;
 #ifdef MADV_HUGEPAGE
-    madvise(leaves, bytes, MADV_HUGEPAGE);  // advice only: failure is fine
+    madvise(owned_leaves, bytes, MADV_HUGEPAGE);  // advice only
 #endif
+    leaves = owned_leaves;
     return true;
   }
+  float* owned_leaves = nullptr;
+  // The packed cache file, mapped read-only for the model's lifetime (the
+  // cache is only ever replaced by rename, so these pages stay this file's).
+  void* mapping = nullptr;
+  size_t mapping_bytes = 0;
   Impl() = default;
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
-  ~Impl() { std::free(leaves); }
+  ~Impl() {
+    std::free(owned_leaves);
+    if (mapping != nullptr) munmap(mapping, mapping_bytes);
+  }
 };
 
 }  // namespace steadiface
