@@ -246,12 +246,15 @@ int main(int argc, char** argv) {
     sink.ns =
         slash == 0 || slash == std::string::npos ? "" : img.substr(0, slash);
   }
-  rosbag::Bag out;
+  // Constructed only for --out: a rosbag::Bag loads rosbag's encryptor
+  // plugins (pluginlib asks rospack for every package's exports).
+  std::unique_ptr<rosbag::Bag> out;
   const std::string out_tmp = a.out + ".part";
   if (!a.out.empty()) {
     try {
-      out.open(out_tmp, rosbag::bagmode::Write);
-      out.setCompression(a.compress == "lz4" ? rosbag::compression::LZ4
+      out.reset(new rosbag::Bag);
+      out->open(out_tmp, rosbag::bagmode::Write);
+      out->setCompression(a.compress == "lz4" ? rosbag::compression::LZ4
                          : a.compress == "bz2"
                              ? rosbag::compression::BZ2
                              : rosbag::compression::Uncompressed);
@@ -263,7 +266,7 @@ int main(int argc, char** argv) {
   }
   std::unique_ptr<steadiface_bag::AsyncBagWriter> writer;
   if (!a.out.empty()) {
-    writer.reset(new steadiface_bag::AsyncBagWriter(&out));
+    writer.reset(new steadiface_bag::AsyncBagWriter(out.get()));
     sink.out = writer.get();
   }
   steadiface_bag::SideBySideVideo video(a.video);
@@ -353,8 +356,8 @@ int main(int argc, char** argv) {
   video.Finish();
   const double elapsed =
       std::chrono::duration<double>(Clock::now() - start).count();
-  if (!a.out.empty()) {
-    out.close();
+  if (out) {
+    out->close();
     if (std::rename(out_tmp.c_str(), a.out.c_str()) != 0) {
       std::cerr << "steadiface_bag: cannot rename " << out_tmp << "\n";
       return 1;
