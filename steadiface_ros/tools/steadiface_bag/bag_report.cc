@@ -7,7 +7,7 @@
 #include <sstream>
 #include <vector>
 
-#include "steadiface_core/eval/scorecard.h"
+#include "steadiface_core/high_pass_rms.h"
 #include "steadiface_core/percentile.h"
 #include "steadiface_core/so3.h"
 #include "steadiface_ros/msg_conversion.h"
@@ -15,13 +15,9 @@
 namespace steadiface_bag {
 namespace {
 
-using steadiface::Percentile;
-
 // The scorecard's definition of jitter: > cutoff RMS, linear trend removed.
-double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
-                   double cutoff) {
-  return steadiface::eval::Scorecard::HighPassRms(x, fps, cutoff);
-}
+using steadiface::HighPassRms;
+using steadiface::Percentile;
 
 // "gyro-only", "steadiface" or "steadiface-layered" (warp/mode layered).
 std::string MethodName(const ReportInputs& r, const BagSink& sink) {

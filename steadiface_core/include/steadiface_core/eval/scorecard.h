@@ -130,8 +130,7 @@ class Scorecard {
   };
   const std::vector<Sample>& samples() const { return samples_; }
 
-  /// High-pass RMS of a 2D trajectory (linear trend removed, FFT bins under
-  /// `cutoff_hz` zeroed) [same units]; exposed for tests.
+  /// steadiface::HighPassRms (high_pass_rms.h), under the scorecard's name.
   static double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
                             double cutoff_hz);
   /// Liu et al. stability of a 2D trajectory's frame-to-frame motion.
