@@ -3,11 +3,12 @@
 #include <cmath>
 #include <sstream>
 
-#include <cv_bridge/cv_bridge.h>
-#include <opencv2/imgcodecs.hpp>
+#include <cstring>
+
 #include <opencv2/imgproc.hpp>
 #include <sensor_msgs/image_encodings.h>
 
+#include "image_decoder.h"
 #include "steadiface_core/so3.h"
 #include "steadiface_ros/time_conversion.h"
 
@@ -215,17 +216,39 @@ steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
       }
       return Status::Ok();
     }
-    // Anything else cv_bridge converts cleanly.
-    cv_bridge::CvImageConstPtr cv = cv_bridge::toCvCopy(msg, channels == 1 && depth == 8 ? enc::MONO8 : enc::BGR8);
-    *image = cv->image;
-    return Status::Ok();
-  } catch (const cv_bridge::Exception& ex) {
-    return Status::Error("image: unsupported encoding '" + e + "' (" + ex.what() +
-                         "); supported: mono8/16, bgr8, rgb8, bgra8, rgba8, yuv422 (UYVY), "
-                         "yuyv/yuv422_yuy2, bayer_*8/16, and compressed via image_transport");
+    // What is left (8UC2, 16UC2: two channels that are not a named 4:2:2
+    // layout) has no picture to make; cv_bridge refuses them too.
+    return Status::Error("image: unsupported encoding '" + e +
+                         "' (two channels, not a YUV 4:2:2 layout); supported: mono8/16, "
+                         "bgr8, rgb8, bgra8, rgba8, yuv422 (UYVY), yuyv/yuv422_yuy2, "
+                         "bayer_*8/16, and compressed via image_transport");
   } catch (const cv::Exception& ex) {
     return Status::Error("image: conversion of '" + e + "' failed: " + ex.what());
   }
+}
+
+sensor_msgs::ImagePtr ToImageMsg(const std_msgs::Header& header, const std::string& encoding,
+                                 const cv::Mat& image) {
+  sensor_msgs::ImagePtr msg(new sensor_msgs::Image);
+  msg->header = header;
+  msg->height = static_cast<uint32_t>(image.rows);
+  msg->width = static_cast<uint32_t>(image.cols);
+  msg->encoding = encoding;
+  msg->is_bigendian = 0;  // OpenCV's pixels are in the host's order
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
+  msg->is_bigendian = 1;
+#endif
+  const size_t row = static_cast<size_t>(image.cols) * image.elemSize();
+  msg->step = static_cast<uint32_t>(row);
+  msg->data.resize(row * static_cast<size_t>(image.rows));
+  if (image.isContinuous()) {
+    if (!msg->data.empty()) std::memcpy(msg->data.data(), image.data, msg->data.size());
+  } else {
+    for (int r = 0; r < image.rows; ++r) {
+      std::memcpy(msg->data.data() + row * static_cast<size_t>(r), image.ptr(r), row);
+    }
+  }
+  return msg;
 }
 
 steadiface::Status FromCompressedImage(const sensor_msgs::CompressedImage& msg,
@@ -243,16 +266,10 @@ steadiface::Status FromCompressedImage(const sensor_msgs::CompressedImage& msg,
   }
   if (msg.data.empty()) return Status::Error("compressed image: no data");
   cv::Mat decoded;
-  try {
-    decoded = cv::imdecode(cv::Mat(1, static_cast<int>(msg.data.size()), CV_8UC1,
-                                   const_cast<uint8_t*>(msg.data.data())),
-                           cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& ex) {
-    decoded.release();
-  }
-  if (decoded.empty()) {
+  std::string why;
+  if (!DecodeImage(msg.data.data(), msg.data.size(), &decoded, &why)) {
     return Status::Error("compressed image: cannot decode the " + std::string(jpeg ? "jpeg" : "png") +
-                         " payload (" + std::to_string(msg.data.size()) + " bytes)");
+                         " payload (" + std::to_string(msg.data.size()) + " bytes): " + why);
   }
   if (decoded.cols > 16384 || decoded.rows > 16384) {
     return Status::Error("compressed image: implausible size " + std::to_string(decoded.cols) +
@@ -269,7 +286,7 @@ steadiface::Status FromCompressedImage(const sensor_msgs::CompressedImage& msg,
   }
   // The decoder gives BGR; a "rgb8; jpeg compressed bgr8" producer encoded
   // BGR too (compressed_image_transport converts before encoding).
-  *out = cv_bridge::CvImage(msg.header, encoding, decoded).toImageMsg();
+  *out = ToImageMsg(msg.header, encoding, decoded);
   return Status::Ok();
 }
 

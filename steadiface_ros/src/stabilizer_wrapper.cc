@@ -1,6 +1,5 @@
 #include "steadiface_ros/stabilizer_wrapper.h"
 
-#include <cv_bridge/cv_bridge.h>
 #include <sensor_msgs/image_encodings.h>
 
 #include "steadiface_core/debug_overlay.h"
@@ -381,7 +380,7 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
                                   : frame.output.channels() == 4
                                         ? sensor_msgs::image_encodings::BGRA8
                                         : sensor_msgs::image_encodings::BGR8;
-      sink_->PublishImage(cv_bridge::CvImage(out_header, enc, frame.output).toImageMsg(), info);
+      sink_->PublishImage(ToImageMsg(out_header, enc, frame.output), info);
     } else {
       sink_->PublishOutputInfo(info);
     }
@@ -473,7 +472,7 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
                                        frame.layered.blend, og.width(), og.height(), &dbg);
       }
       sink_->PublishDebugImage(
-          cv_bridge::CvImage(in_header, sensor_msgs::image_encodings::BGR8, dbg).toImageMsg());
+          ToImageMsg(in_header, sensor_msgs::image_encodings::BGR8, dbg));
     }
     status_.gyro_video_check = frame.gyro_video_check;
     status_.imu_offset_applied_s = frame.imu_offset_applied_s;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <cv_bridge/cv_bridge.h>
 #include <gtest/gtest.h>
 #include <sensor_msgs/image_encodings.h>
 #include <opencv2/imgcodecs.hpp>
@@ -172,8 +173,9 @@ TEST(ImageFormatsTest, Mono16IsScaledFromItsFullRange) {
 
 TEST(ImageFormatsTest, DepthAndUnknownImagesAreRefusedNamingTheEncoding) {
   cv::Mat out;
-  for (const std::string e : {"32FC1", "16SC1", "no_such_encoding"}) {
-    const int bpp = e == "32FC1" ? 4 : 2;
+  for (const std::string e :
+       {"32FC1", "16SC1", "no_such_encoding", "8UC2", "16UC2"}) {
+    const int bpp = e == "32FC1" || e == "16UC2" ? 4 : 2;
     const steadiface::Status s = ToCvImage(Message(e, 8, 8, bpp), &out);
     EXPECT_FALSE(s.ok()) << e;
     EXPECT_NE(s.message().find(e), std::string::npos) << s.message();
@@ -231,6 +233,53 @@ TEST(ImageFormatsTest, CompressedJpegAndPngAsImageTransportPublishesThem) {
   EXPECT_NE(s.message().find("depth"), std::string::npos) << s.message();
   broken.data.clear();
   EXPECT_FALSE(FromCompressedImage(broken, &msg).ok());
+}
+
+// ToImageMsg (which the stabilized and the debug images go out through)
+// gives the very message cv_bridge's CvImage::toImageMsg gives, for
+// continuous images and for a non-continuous view (rows copied tightly).
+TEST(ImageFormatsTest, ToImageMsgIsWhatCvBridgeGives) {
+  std_msgs::Header h;
+  h.stamp.fromSec(3.25);
+  h.frame_id = "cam_stabilized";
+  h.seq = 7;
+  const cv::Mat bgr = Picture(37, 23);
+  cv::Mat grey, bgra, grey16;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(bgr, bgra, cv::COLOR_BGR2BGRA);
+  grey.convertTo(grey16, CV_16U, 257.0);
+  const cv::Mat view = bgr(cv::Rect(3, 2, 30, 17));  // not continuous
+  ASSERT_FALSE(view.isContinuous());
+  struct Case {
+    cv::Mat img;
+    std::string encoding;
+  };
+  for (const Case& c : std::vector<Case>{{bgr, enc::BGR8},
+                                         {grey, enc::MONO8},
+                                         {bgra, enc::BGRA8},
+                                         {grey16, enc::MONO16},
+                                         {view, enc::BGR8},
+                                         {cv::Mat(), enc::BGR8}}) {
+    const sensor_msgs::ImagePtr ours = ToImageMsg(h, c.encoding, c.img);
+    const sensor_msgs::ImagePtr theirs =
+        cv_bridge::CvImage(h, c.encoding, c.img).toImageMsg();
+    EXPECT_EQ(ours->header.stamp, theirs->header.stamp);
+    EXPECT_EQ(ours->header.frame_id, theirs->header.frame_id);
+    EXPECT_EQ(ours->header.seq, theirs->header.seq);
+    EXPECT_EQ(ours->height, theirs->height) << c.encoding;
+    EXPECT_EQ(ours->width, theirs->width) << c.encoding;
+    EXPECT_EQ(ours->encoding, theirs->encoding);
+    EXPECT_EQ(ours->is_bigendian, theirs->is_bigendian);
+    EXPECT_EQ(ours->step, theirs->step) << c.encoding;
+    EXPECT_TRUE(ours->data == theirs->data) << c.encoding;
+    if (!c.img.empty()) {
+      cv::Mat back;
+      ASSERT_TRUE(ToCvImage(*ours, &back).ok());
+      if (c.img.depth() == CV_8U && c.img.channels() != 4) {
+        EXPECT_EQ(MaxDiff(back, c.img, 0), 0) << c.encoding;
+      }
+    }
+  }
 }
 
 }  // namespace

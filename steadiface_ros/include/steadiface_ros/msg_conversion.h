@@ -49,6 +49,13 @@ geometry_msgs::Transform ToTransformMsg(const Eigen::Quaterniond& q);
 /// message's memory: keep the message alive while using it.
 steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image);
 
+/// cv::Mat -> sensor_msgs/Image with `header` and `encoding` (the caller
+/// names the encoding of the Mat's pixel type), rows copied tightly (step =
+/// width * pixel size): what cv_bridge::CvImage::toImageMsg gives, without
+/// linking cv_bridge, whose OpenCV imgcodecs brings ~110 libraries.
+sensor_msgs::ImagePtr ToImageMsg(const std_msgs::Header& header, const std::string& encoding,
+                                 const cv::Mat& image);
+
 /// sensor_msgs/CompressedImage (jpeg or png, as compressed_image_transport
 /// publishes it on <image>/compressed) -> a decoded image message with the
 /// same header: mono8/bgr8/bgra8, or mono16/bgr16 for a 16-bit png. A

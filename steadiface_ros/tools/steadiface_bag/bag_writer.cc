@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <iostream>
 
-#include <cv_bridge/cv_bridge.h>
 #include <tf2_msgs/TFMessage.h>
 #include <opencv2/imgproc.hpp>
 
@@ -96,6 +95,25 @@ SideBySideVideo::~SideBySideVideo() {
   }
 }
 
+namespace {
+
+// One of the tool's own images (bgr8, bgra8 or mono8) as a BGR copy; empty
+// if it does not convert.
+cv::Mat ToBgr(const sensor_msgs::Image& image) {
+  cv::Mat mat, bgr;
+  if (!steadiface_ros::ToCvImage(image, &mat).ok()) return bgr;
+  if (mat.channels() == 1) {
+    cv::cvtColor(mat, bgr, cv::COLOR_GRAY2BGR);
+  } else if (mat.channels() == 4) {
+    cv::cvtColor(mat, bgr, cv::COLOR_BGRA2BGR);
+  } else {
+    bgr = mat.clone();
+  }
+  return bgr;
+}
+
+}  // namespace
+
 void SideBySideVideo::AddInput(const sensor_msgs::Image& image) {
   if (!enabled()) return;
   cv::Mat mat;
@@ -112,9 +130,10 @@ void SideBySideVideo::AddOutput(BagSink* sink) {
   if (it == inputs_.end()) return;
   cv::Mat left = it->second, right;
   if (sink->debug && sink->last_debug && sink->last_debug->header.stamp == t) {
-    left = cv_bridge::toCvCopy(sink->last_debug, "bgr8")->image;
+    left = ToBgr(*sink->last_debug);
   }
-  right = cv_bridge::toCvCopy(sink->last_image, "bgr8")->image;
+  right = ToBgr(*sink->last_image);
+  if (left.empty() || right.empty()) return;
   if (left.channels() == 1) cv::cvtColor(left, left, cv::COLOR_GRAY2BGR);
   cv::resize(right, right, left.size());
   cv::Mat both;
