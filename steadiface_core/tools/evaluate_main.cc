@@ -51,6 +51,8 @@ int Usage() {
                "         trace: scale its rotation, or play it K times as fast)\n"
                "       [--search-interval S] (face.search_interval: full-frame face search\n"
                "         at most once per S while no face is locked; 0 = every frame)\n"
+               "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
+               "         head target's smoothing, Eq. 1)\n"
                "         (the layered warp's warp/layered/* options, for sweeps)\n";
   return 2;
 }
@@ -73,6 +75,8 @@ int main(int argc, char** argv) {
   // The recorded trace's scale and playback speed (NaN: the preset's).
   double gyro_scale = NAN, gyro_speed = NAN;
   double search_interval = NAN;  // face.search_interval [s]; NaN: the default
+  double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
+  double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -93,6 +97,8 @@ int main(int argc, char** argv) {
     else if (a == "--gyro-scale") gyro_scale = std::atof(next().c_str());
     else if (a == "--gyro-speed") gyro_speed = std::atof(next().c_str());
     else if (a == "--search-interval") search_interval = std::atof(next().c_str());
+    else if (a == "--head-w-stay") head_w_stay = std::atof(next().c_str());
+    else if (a == "--head-d-ref") head_d_ref = std::atof(next().c_str());
     else if (a == "--band") blend.band_width = std::atof(next().c_str());
     else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
     else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
@@ -242,6 +248,8 @@ int main(int argc, char** argv) {
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
         if (std::isfinite(search_interval)) po.face.search_interval_s = search_interval;
+        if (std::isfinite(head_w_stay)) po.stabilizer.head.w_stay = head_w_stay;
+        if (std::isfinite(head_d_ref)) po.stabilizer.head.d_ref = head_d_ref;
         po.warp.layered.blend = blend;
         po.imu.imu_time_offset_s += offset_error;
         po.shutter.readout_time_s = std::max(0.0, po.shutter.readout_time_s + readout_error);
