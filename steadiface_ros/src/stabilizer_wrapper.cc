@@ -38,12 +38,10 @@ StabilizerWrapper::StabilizerWrapper(const steadiface::PipelineOptions& pipeline
   }
 }
 
-StabilizerWrapper::~StabilizerWrapper() {
-  if (render_.joinable()) render_.join();
-}
+StabilizerWrapper::~StabilizerWrapper() { render_.Wait(); }
 
 void StabilizerWrapper::FinishHeld() {
-  if (render_.joinable()) render_.join();
+  render_.Wait();
   if (!held_) return;
   std::unique_ptr<Held> h = std::move(held_);
   Publish(h->p, h->frame, h->image, h->extrapolated, false, h->started);
@@ -360,7 +358,7 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   FinishHeld();
   held_.reset(new Held{p, std::move(frame), image, extrapolated, started});
   Held* h = held_.get();
-  render_ = std::thread([h] { steadiface::Pipeline::RenderDeferred(h->image, &h->frame); });
+  render_.Start([h] { steadiface::Pipeline::RenderDeferred(h->image, &h->frame); });
 }
 
 void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFrame& frame,

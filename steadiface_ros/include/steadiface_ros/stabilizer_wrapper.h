@@ -4,7 +4,6 @@
 #include <functional>
 #include <memory>
 #include <mutex>
-#include <thread>
 #include <string>
 #include <vector>
 
@@ -21,6 +20,7 @@
 #include "steadiface_core/pipeline.h"
 #include "steadiface_ros/frusta_markers.h"
 #include "steadiface_ros/params.h"
+#include "steadiface_ros/render_worker.h"
 
 namespace steadiface_ros {
 
@@ -197,7 +197,7 @@ class StabilizerWrapper {
     ros::Time started;
   };
   std::unique_ptr<Held> held_;
-  std::thread render_;
+  RenderWorker render_;  // declared after held_: destroyed (joined) first
 
   std::mutex options_mutex_;
   bool options_pending_ = false;
