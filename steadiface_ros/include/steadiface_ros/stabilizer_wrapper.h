@@ -113,7 +113,10 @@ struct WrapperStatus {
 /// serialized by the owner (the nodelet runs them on one callback queue).
 /// RequestStabilizerOptions() may be called from any thread (the
 /// dynamic_reconfigure server's): it only stores the request under its own
-/// mutex; the next frame applies it.
+/// mutex; the next frame applies it. With `pipelined`, a processed frame
+/// renders on the wrapper's one RenderWorker thread while the owner's
+/// thread processes the next; the owner's thread publishes it (the sink is
+/// only ever called from the owner's thread).
 class StabilizerWrapper {
  public:
   /// `extrinsic_lookup(imu_frame, camera_frame, &R_cam_imu)` (optional) is
