@@ -61,6 +61,12 @@ const Module& LoadedModule() {
 
 }  // namespace
 
+bool LoadImageDecoder(std::string* why) {
+  const Module& m = LoadedModule();
+  if (m.decode == nullptr) *why = m.error;
+  return m.decode != nullptr;
+}
+
 bool DecodeImage(const uint8_t* data, size_t size, cv::Mat* out,
                  std::string* why) {
   const Module& m = LoadedModule();

@@ -14,6 +14,11 @@
 
 namespace steadiface_ros {
 
+/// Loads the module now (a node that subscribes to compressed images does
+/// so at start-up, not on its first frame). False, with `why`, if it cannot
+/// be loaded. Thread-safe; the module is loaded once per process.
+bool LoadImageDecoder(std::string* why);
+
 /// Decodes a jpeg or png payload as cv::imdecode(..., IMREAD_UNCHANGED)
 /// does. False, with `why`, when the module cannot be loaded or the payload
 /// does not decode. Thread-safe.

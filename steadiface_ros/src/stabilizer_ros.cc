@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "image_decoder.h"
 #include "steadiface_ros/msg_conversion.h"
 
 namespace steadiface_ros {
@@ -108,6 +109,12 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   const image_transport::TransportHints hints(builtin_compressed ? "raw" : transport,
                                               ros::TransportHints(), pnh_);
   if (builtin_compressed) {
+    std::string why;
+    if (!LoadImageDecoder(&why)) {
+      ROS_ERROR("[%s] image_transport 'compressed': %s; every compressed frame will be "
+                "skipped",
+                name_.c_str(), why.c_str());
+    }
     compressed_sub_ = nh_.subscribe("image_raw/compressed", 5, &StabilizerRos::OnCompressed, this);
     info_sub_ = nh_.subscribe("camera_info", 5, &StabilizerRos::OnCameraInfo, this);
   } else if (info_source_->has_file_info()) {
