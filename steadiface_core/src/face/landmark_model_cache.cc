@@ -238,6 +238,13 @@ bool LandmarkPredictor::Impl::ReadPackedCache(const std::string& file,
   }
   const uint64_t n = static_cast<uint64_t>(m->initial_shape.size());
   const uint64_t parts = n / 2;
+  // The leaf block must fit in the file: checked before anything is sized
+  // by these counts (a damaged count cannot ask for more than the file).
+  const uint64_t floats = n_cascades * trees * leaves_per_tree * n;
+  if (floats / n / leaves_per_tree / trees != n_cascades ||
+      floats > mapped.size() / sizeof(float)) {
+    return false;
+  }
   m->forests.resize(n_cascades);  // their count only: the trees are packed
   m->anchor_idx.resize(n_cascades);
   m->deltas.resize(n_cascades);
@@ -274,10 +281,8 @@ bool LandmarkPredictor::Impl::ReadPackedCache(const std::string& file,
       offset < mapped.size() - r.left() || offset > mapped.size()) {
     return false;
   }
-  const uint64_t floats = n_cascades * trees * leaves_per_tree * n;
   const uint64_t block = mapped.size() - offset;
-  if (floats / n / leaves_per_tree / trees != n_cascades ||
-      block < sizeof(kPackedMagic) ||
+  if (block < sizeof(kPackedMagic) ||
       (block - sizeof(kPackedMagic)) / sizeof(float) != floats ||
       (block - sizeof(kPackedMagic)) % sizeof(float) != 0) {
     return false;
