@@ -29,6 +29,35 @@ namespace {
 
 using testing_util::LoadImage;
 
+// A value of type T at byte `offset` of the file `path`, read or written in
+// place (the checks that damage a cache file); false on any I/O failure.
+template <class T>
+bool ReadAt(const std::string& path, long offset, T* value) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return false;
+  const bool ok = std::fseek(f, offset, SEEK_SET) == 0 &&
+                  std::fread(value, sizeof(T), 1, f) == 1;
+  std::fclose(f);
+  return ok;
+}
+template <class T>
+bool WriteAt(const std::string& path, long offset, const T& value) {
+  std::FILE* f = std::fopen(path.c_str(), "r+b");
+  if (f == nullptr) return false;
+  const bool ok = std::fseek(f, offset, SEEK_SET) == 0 &&
+                  std::fwrite(&value, sizeof(T), 1, f) == 1;
+  return std::fclose(f) == 0 && ok;
+}
+
+// Where a landmark cache's cascade count is: after the magic, the model
+// file's size and mtime, its name (with its length at byte 24) and the
+// shape's 136 floats (with their count). -1 if unreadable.
+long CascadeCountOffset(const std::string& path) {
+  uint64_t len = 0;
+  if (!ReadAt(path, 24, &len)) return -1;
+  return static_cast<long>(32 + len + 8 + 136 * 4);
+}
+
 // Our cascade (on the packed trees) against dlib's own shape_predictor on a
 // real photo, for boxes around the face and off it (other leaves): every
 // part dlib reports (rounded to whole pixels by dlib) is ours rounded the
@@ -128,22 +157,12 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
   // Damage a count (the number of cascades, to one the file's size would
   // allow on its own): refused, decoded again from the model file.
   {
-    std::FILE* f = std::fopen(files[0].c_str(), "r+b");
-    ASSERT_NE(f, nullptr);
-    uint64_t len = 0;
-    ASSERT_EQ(std::fseek(f, 24, SEEK_SET), 0);  // magic, size, mtime
-    ASSERT_EQ(std::fread(&len, sizeof(len), 1, f), 1u);
-    // The name, the shape's count and its 136 floats, then the cascades'.
-    ASSERT_EQ(std::fseek(f, static_cast<long>(32 + len + 8 + 136 * 4), SEEK_SET),
-              0);
+    const long at = CascadeCountOffset(files[0]);
     uint64_t cascades = 0;
-    ASSERT_EQ(std::fread(&cascades, sizeof(cascades), 1, f), 1u);
+    ASSERT_TRUE(ReadAt(files[0], at, &cascades));
     EXPECT_EQ(cascades, 15u);  // the 68-point model's
     const uint64_t damaged = static_cast<uint64_t>(full_size) / 16;
-    ASSERT_EQ(std::fseek(f, static_cast<long>(32 + len + 8 + 136 * 4), SEEK_SET),
-              0);
-    ASSERT_EQ(std::fwrite(&damaged, sizeof(damaged), 1, f), 1u);
-    std::fclose(f);
+    ASSERT_TRUE(WriteAt(files[0], at, damaged));
     std::unique_ptr<LandmarkPredictor> p;
     ASSERT_TRUE(
         LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
@@ -156,31 +175,22 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
   // A split index past the cascade's features (Predict would read out of
   // bounds with it): refused, decoded again, rewritten.
   {
-    std::FILE* f = std::fopen(files[0].c_str(), "r+b");
-    ASSERT_NE(f, nullptr);
-    uint64_t len = 0;
-    ASSERT_EQ(std::fseek(f, 24, SEEK_SET), 0);
-    ASSERT_EQ(std::fread(&len, sizeof(len), 1, f), 1u);
-    // Header, shape, then the counts: cascades, trees, splits and leaves
-    // per tree; then per cascade its 500 anchors and 500 deltas (each with
-    // its count), then the split count and the first split's idx1.
-    const long counts = static_cast<long>(32 + len + 8 + 136 * 4);
+    // After the cascade count: trees, splits and leaves per tree; then per
+    // cascade its 500 anchors and 500 deltas (each with its count), then
+    // the split count and the first split's idx1.
+    const long counts = CascadeCountOffset(files[0]);
     uint64_t c[4] = {0, 0, 0, 0};
-    ASSERT_EQ(std::fseek(f, counts, SEEK_SET), 0);
-    ASSERT_EQ(std::fread(c, sizeof(uint64_t), 4, f), 4u);
+    for (int i = 0; i < 4; ++i)
+      ASSERT_TRUE(ReadAt(files[0], counts + 8 * i, &c[i]));
     EXPECT_EQ(c[0], 15u);
     EXPECT_EQ(c[1], 500u);
     EXPECT_EQ(c[2], 15u);
     EXPECT_EQ(c[3], 16u);
     const long first_split = counts + 32 + 15 * (8 + 500 * 8 + 8 + 500 * 8) + 8;
     uint32_t idx1 = 0;
-    ASSERT_EQ(std::fseek(f, first_split, SEEK_SET), 0);
-    ASSERT_EQ(std::fread(&idx1, sizeof(idx1), 1, f), 1u);
+    ASSERT_TRUE(ReadAt(files[0], first_split, &idx1));
     EXPECT_LT(idx1, 500u);
-    const uint32_t damaged = 500;
-    ASSERT_EQ(std::fseek(f, first_split, SEEK_SET), 0);
-    ASSERT_EQ(std::fwrite(&damaged, sizeof(damaged), 1, f), 1u);
-    std::fclose(f);
+    ASSERT_TRUE(WriteAt(files[0], first_split, uint32_t{500}));
     std::unique_ptr<LandmarkPredictor> p;
     ASSERT_TRUE(
         LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
