@@ -5,6 +5,8 @@
 #include <climits>
 #include <vector>
 
+#include "steadiface_ros/module_loader.h"
+
 namespace steadiface_ros {
 namespace {
 
@@ -38,14 +40,8 @@ const Module& LoadedModule() {
     const std::string dir = OwnDirectory();
     if (!dir.empty()) candidates.push_back(dir + "/" + kModule);
     candidates.push_back(kModule);  // the library path
-    void* handle = nullptr;
     std::string errors;
-    for (const std::string& c : candidates) {
-      handle = dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL);
-      if (handle != nullptr) break;
-      const char* e = dlerror();
-      errors += std::string(errors.empty() ? "" : "; ") + (e ? e : c);
-    }
+    void* handle = OpenModule(candidates, &errors);
     if (handle == nullptr) {
       m.error = "cannot load the image decoder module (" + errors + ")";
       return m;

@@ -6,6 +6,8 @@
 
 #include <vector>
 
+#include "steadiface_ros/module_loader.h"
+
 namespace steadiface_bag {
 
 namespace {
@@ -34,14 +36,8 @@ std::unique_ptr<VideoEncoder> OpenVideoEncoder(const std::string& path,
   const std::string dir = ExeDir();
   if (!dir.empty()) candidates.push_back(dir + "/../" + kModule);
   candidates.push_back(kModule);
-  void* handle = nullptr;
   std::string errors;
-  for (const std::string& c : candidates) {
-    handle = dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL);
-    if (handle != nullptr) break;
-    const char* e = dlerror();
-    errors += std::string(errors.empty() ? "" : "; ") + (e ? e : c);
-  }
+  void* handle = steadiface_ros::OpenModule(candidates, &errors);
   if (handle == nullptr) {
     *why = "cannot load the video encoder module (" + errors + ")";
     return nullptr;
