@@ -38,7 +38,8 @@ StabilizerWrapper::StabilizerWrapper(const steadiface::PipelineOptions& pipeline
   }
 }
 
-StabilizerWrapper::~StabilizerWrapper() { render_.Wait(); }
+// render_ (declared after held_) waits for the frame in hand as it goes.
+StabilizerWrapper::~StabilizerWrapper() = default;
 
 void StabilizerWrapper::FinishHeld() {
   render_.Wait();

@@ -97,8 +97,8 @@ SideBySideVideo::~SideBySideVideo() {
 
 namespace {
 
-// One of the tool's own images (bgr8, bgra8 or mono8) as a BGR copy; empty
-// if it does not convert.
+// An image message as a BGR copy (grey and BGRA converted), for the side
+// by side video; empty if it does not convert.
 cv::Mat ToBgr(const sensor_msgs::Image& image) {
   cv::Mat mat, bgr;
   if (!steadiface_ros::ToCvImage(image, &mat).ok()) return bgr;
@@ -116,9 +116,8 @@ cv::Mat ToBgr(const sensor_msgs::Image& image) {
 
 void SideBySideVideo::AddInput(const sensor_msgs::Image& image) {
   if (!enabled()) return;
-  cv::Mat mat;
-  if (steadiface_ros::ToCvImage(image, &mat).ok())
-    inputs_[image.header.stamp] = mat.clone();
+  cv::Mat bgr = ToBgr(image);
+  if (!bgr.empty()) inputs_[image.header.stamp] = bgr;
   while (inputs_.size() > 32) inputs_.erase(inputs_.begin());
 }
 
@@ -134,7 +133,6 @@ void SideBySideVideo::AddOutput(BagSink* sink) {
   }
   right = ToBgr(*sink->last_image);
   if (left.empty() || right.empty()) return;
-  if (left.channels() == 1) cv::cvtColor(left, left, cv::COLOR_GRAY2BGR);
   cv::resize(right, right, left.size());
   cv::Mat both;
   cv::hconcat(left, right, both);
