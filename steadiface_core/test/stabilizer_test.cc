@@ -278,6 +278,39 @@ TEST(StabilizerTest, ProtrusionIsRemovedByBinarySearch) {
   EXPECT_EQ(r.undefined, 0);
 }
 
+// Where the crop margin runs out, E_p is a stiff wall the solve slides
+// along: the default iteration cap lets it finish (paper: "usually converges
+// within 3 iterations", which holds only while the margin lasts).
+TEST(StabilizerTest, SolvesConvergeWhereTheMarginRunsOut) {
+  const CameraModel m = Model640x360();
+  sim::LandmarkSequenceOptions o = Walk();
+  o.camera.shake_rms_rad = 0.03;
+  o.duration_s = 3.0;
+  const sim::LandmarkSequence seq(m, o);
+  auto count = [&](int max_iterations, int* long_solves) {
+    StabilizerOptions so;
+    so.solver.max_iterations = max_iterations;
+    so.solver.max_time_s = 10.0;  // the count must not depend on the machine
+    const RunResult r = RunSequence(m, seq, so);
+    int unconverged = 0;
+    *long_solves = 0;
+    for (const auto& f : r.frames_out) {
+      unconverged += f.solver.termination == "NO_CONVERGENCE";
+      *long_solves += f.solver.iterations > 10;
+    }
+    return unconverged;
+  };
+  int long_default = 0, long_ten = 0;
+  const int unconverged_default = count(StabilizerOptions().solver.max_iterations, &long_default);
+  const int unconverged_ten = count(10, &long_ten);
+  std::cout << "[ convergence ] unconverged solves: default cap " << unconverged_default
+            << " (" << long_default << " took > 10 iterations), cap 10 " << unconverged_ten
+            << " of " << seq.frames().size() << "\n";
+  EXPECT_GT(unconverged_ten, 10);  // the case exists
+  EXPECT_LE(unconverged_default * 10, static_cast<int>(seq.frames().size()));
+  EXPECT_LE(unconverged_default * 3, unconverged_ten);
+}
+
 TEST(StabilizerTest, DeterministicAndResettable) {
   const CameraModel m = Model640x360();
   sim::LandmarkSequenceOptions o = Walk();

@@ -410,7 +410,7 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
   ceres::Solver::Summary summary;
   // A time cap that runs out before the first step (a stall) would leave the
   // initial pose, the previous warp with this frame's shake in it: the
-  // solve is then rerun under the iteration cap alone (10 cheap steps).
+  // solve is then rerun under the iteration cap alone.
   if (StallTolerantSolve(so, &problem,
                          [&] {
                            pp->q() = R_v0.coeffs();
