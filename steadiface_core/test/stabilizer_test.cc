@@ -18,6 +18,7 @@
 namespace steadiface {
 namespace {
 
+using testing_util::At;
 using testing_util::Model640x360;
 
 // ---------- Stabilizer on ground-truth sequences ----------
@@ -309,6 +310,86 @@ TEST(StabilizerTest, SolvesConvergeWhereTheMarginRunsOut) {
   EXPECT_GT(unconverged_ten, 10);  // the case exists
   EXPECT_LE(unconverged_default * 10, static_cast<int>(seq.frames().size()));
   EXPECT_LE(unconverged_default * 3, unconverged_ten);
+}
+
+// A world-fixed face high in the frame, seen by a shaking rolling-shutter
+// camera: its landmarks are read 40 % of a readout before the middle row.
+// Where the stabilizer reads the landmark centre (Eq. 1's C in the predicted
+// virtual view, and the gyro-compensated centre of the variation measure),
+// each landmark must go through its own row's rotation, as E_f moves it.
+TEST(StabilizerTest, FaceCentreUsesEachLandmarksRowRotation) {
+  const CameraModel m = Model640x360();
+  RollingShutterOptions rs;
+  rs.readout_time_s = 0.03;
+  const RowTiming timing(rs, 360);
+  OrientationTimeline tl{OrientationTimelineOptions()};
+  // About 2 rad/s peak shake about x and y, a different rate on each.
+  auto omega = [](double t) {
+    return Eigen::Vector3d(2.0 * std::sin(2 * M_PI * 4.0 * t),
+                           1.5 * std::sin(2 * M_PI * 5.3 * t + 1.0), 0.0);
+  };
+  for (int i = 0; i <= 400; ++i) ASSERT_EQ(tl.AddSample({At(i / 200.0), omega(i / 200.0)}),
+                                           SampleResult::kAccepted);
+  // The face: 12 points around (0.5, 0.15) as the camera at t = 0 saw them.
+  const Eigen::Quaterniond R0 = [&] {
+    Eigen::Quaterniond q;
+    EXPECT_TRUE(QuerySucceeded(tl.RealRotation(At(0.0), &q)));
+    return q;
+  }();
+  std::vector<Eigen::Vector2d> world;
+  for (int k = 0; k < 12; ++k) {
+    world.emplace_back(0.5 + 0.04 * std::cos(k * M_PI / 6), 0.15 + 0.05 * std::sin(k * M_PI / 6));
+  }
+  std::unique_ptr<Stabilizer> stab;
+  ASSERT_TRUE(Stabilizer::Create(m, OutputOptions(), StabilizerOptions(), &stab).ok());
+  std::vector<StabilizerFrame> out;
+  for (int i = 0; i < 12; ++i) {
+    const Time stamp = At(0.1 + i / 30.0);
+    RowRotations rows;
+    ASSERT_TRUE(QuerySucceeded(RowRotations::Build(tl, timing, stamp, 32, &rows)));
+    FaceObservation face;
+    face.valid = true;
+    face.confidence = 1.0;
+    for (const Eigen::Vector2d& w : world) {
+      // The row the point is read on: the fixed point of row -> rotation.
+      double row = 0.5 * 359;
+      Eigen::Vector2d p;
+      for (int it = 0; it < 10; ++it) {
+        ASSERT_TRUE(m.Project(w, rows.At(row), Eigen::Vector2d::Zero(), R0, &p));
+        row = std::min(std::max(m.NormalizedToPixel(p).y(), 0.0), 359.0);
+      }
+      face.landmarks.push_back(p);
+      face.landmark_rows.push_back(row);
+    }
+    ComputeCentreAndScale(&face);
+    StabilizerFrame f;
+    ASSERT_TRUE(stab->Process(stamp, tl, timing, &face, &f).ok());
+    if (i >= 2) {
+      // C: in the view predicted from the last two virtual poses.
+      const StabilizerFrame &a = out[i - 2], &b = out[i - 1];
+      const Eigen::Quaterniond R_pred = ((b.R_v * a.R_v.conjugate()) * b.R_v).normalized();
+      const Eigen::Vector2d t_pred = 2.0 * b.t - a.t;
+      Eigen::Vector2d per_row = Eigen::Vector2d::Zero(), middle;
+      for (size_t k = 0; k < face.landmarks.size(); ++k) {
+        Eigen::Vector2d p;
+        ASSERT_TRUE(m.Project(face.landmarks[k], R_pred, t_pred, f.rows.At(face.landmark_rows[k]),
+                              &p));
+        per_row += p / face.landmarks.size();
+      }
+      ASSERT_TRUE(m.Project(face.centre, R_pred, t_pred, f.R_r, &middle));
+      EXPECT_NEAR((f.C - per_row).norm(), 0.0, 1e-9) << "frame " << i;
+      // The test means something: the middle row's rotation would be far off.
+      EXPECT_GT((middle - per_row).norm() * 640, 2.0) << "frame " << i;
+    }
+    out.push_back(f);
+  }
+  // The world-fixed face has no landmark noise: its gyro-compensated centre
+  // and scale do not move, so the variation measure stays at 0 and w_f
+  // whole. (Through the middle row, the skew swung the centre by pixels per
+  // frame and the stretch the scale, and w_f fell to its 0.15 floor.)
+  EXPECT_LT(out.back().factors.centre_variation, 1e-6);
+  EXPECT_LT(out.back().factors.scale_variation, 1e-6);
+  EXPECT_DOUBLE_EQ(out.back().factors.variation_target, 1.0);
 }
 
 TEST(StabilizerTest, DeterministicAndResettable) {

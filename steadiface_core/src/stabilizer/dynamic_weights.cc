@@ -24,7 +24,8 @@ void DynamicWeights::reset() {
 
 WeightFactors DynamicWeights::Update(double dt_s, double mean_angular_speed,
                                      const FaceObservation* face,
-                                     const Eigen::Vector2d& stabilized_centre) {
+                                     const Eigen::Vector2d& stabilized_centre,
+                                     double stabilized_scale) {
   const DynamicWeightOptions& o = options_;
   const bool has_face = face != nullptr && face->valid;
   WeightFactors f;
@@ -49,7 +50,7 @@ WeightFactors DynamicWeights::Update(double dt_s, double mean_angular_speed,
     }
     if (has_face) {
       history_.emplace_back(stabilized_centre.x(), stabilized_centre.y(),
-                            face->scale);
+                            stabilized_scale);
       while (static_cast<int>(history_.size()) > o.variation_window) {
         history_.pop_front();
       }

@@ -59,6 +59,36 @@ double TermEnergy(ceres::Problem* problem,
   return 2.0 * cost;
 }
 
+// The landmark centre as the camera (R_v, t) shows it: the mean of the
+// landmarks, each moved through the real rotation of the row it was read on,
+// as E_f moves them. Through the middle row's rotation alone, a face off the
+// middle row would be off by the rotation over the rows between (at 120 deg/s
+// and a 30 ms readout, about 1 deg for a face a quarter frame away), and that
+// error shakes with the camera. Landmarks without rows use the middle row.
+// `scale` (optional): the RMS distance of the moved landmarks to it. False
+// when a landmark lies behind the camera.
+bool ProjectFaceCentre(const CameraModel& model, const FaceObservation& face,
+                       const RowRotations& rows, const Eigen::Quaterniond& R_r_middle,
+                       const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+                       Eigen::Vector2d* centre, double* scale = nullptr) {
+  std::vector<Eigen::Vector2d> moved(face.landmarks.size());
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (size_t i = 0; i < face.landmarks.size(); ++i) {
+    const Eigen::Quaterniond& R_row =
+        face.landmark_rows.empty() ? R_r_middle : rows.At(face.landmark_rows[i]);
+    if (!model.Project(face.landmarks[i], R_v, t, R_row, &moved[i])) return false;
+    sum += moved[i];
+  }
+  if (moved.empty()) return false;
+  *centre = sum / static_cast<double>(moved.size());
+  if (scale != nullptr) {
+    double s2 = 0.0;
+    for (const Eigen::Vector2d& p : moved) s2 += (p - *centre).squaredNorm();
+    *scale = std::sqrt(s2 / moved.size());
+  }
+  return true;
+}
+
 }  // namespace
 
 Status Stabilizer::Create(const CameraModel& model,
@@ -215,11 +245,14 @@ StabilizerWeights Stabilizer::DynamicWeightsStep(Time stamp, const OrientationTi
     mean_speed = -1.0;
   }
   Eigen::Vector2d stabilized_centre = Eigen::Vector2d::Zero();
-  if (face != nullptr) {
-    model_.Project(face->centre, R_reference_, Eigen::Vector2d::Zero(), f->R_r,
-                   &stabilized_centre);
+  double stabilized_scale = 0.0;
+  if (face != nullptr &&
+      !ProjectFaceCentre(model_, *face, f->rows, f->R_r, R_reference_, Eigen::Vector2d::Zero(),
+                         &stabilized_centre, &stabilized_scale)) {
+    stabilized_centre = face->centre;
+    stabilized_scale = face->scale;
   }
-  f->factors = dynamic->Update(dt, mean_speed, face, stabilized_centre);
+  f->factors = dynamic->Update(dt, mean_speed, face, stabilized_centre, stabilized_scale);
   StabilizerWeights w = options_.weights;
   w.fit = without_fit ? 0.0 : w.fit * f->factors.fit;
   w.rotation_c0 *= f->factors.smoothness;
@@ -291,13 +324,14 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
                                          ? Eigen::Vector2d(2.0 * layer.t_prev - layer.t_prev_prev)
                                          : layer.t_prev;
       Eigen::Vector2d c;
-      if (model_.Project(face->centre, R_pred, t_pred, f->R_r, &c)) f->C = c;
+      if (ProjectFaceCentre(model_, *face, f->rows, f->R_r, R_pred, t_pred, &c)) f->C = c;
     }
     Eigen::Vector2d H_prev = layer.H_prev;
     if (!layer.has_H) {
-      // Start where the face appears in the virtual view now: no jump.
+      // Start where the face appears in the virtual view now: no jump. (From
+      // the landmarks: f->C may already be in the predicted virtual view.)
       Eigen::Vector2d p;
-      H_prev = model_.Project(f->C, R_v0, t0, f->R_r, &p) ? p : f->C;
+      H_prev = ProjectFaceCentre(model_, *face, f->rows, f->R_r, R_v0, t0, &p) ? p : f->C;
     }
     f->H = smoother_.Solve(H_prev, f->C, output_.margin());
     f->has_target = true;

@@ -43,11 +43,15 @@ class DynamicWeights {
   /// `dt_s` since the previous frame (<= 0 on the first frame: factors jump
   /// straight to their targets); `mean_angular_speed` over the window
   /// (negative = unknown, counts as active); `face` may be null;
-  /// `stabilized_centre` is C mapped through R_r only (camera shake removed),
-  /// meaningful when the face is valid.
+  /// `stabilized_centre` and `stabilized_scale` are C and the face scale as
+  /// a world-fixed camera sees them (camera shake removed: each landmark
+  /// through the real rotation of its own row, so rolling-shutter skew is
+  /// not counted as landmark noise) [normalized], meaningful when the face is
+  /// valid.
   WeightFactors Update(double dt_s, double mean_angular_speed,
                        const FaceObservation* face,
-                       const Eigen::Vector2d& stabilized_centre);
+                       const Eigen::Vector2d& stabilized_centre,
+                       double stabilized_scale);
 
   void reset();
   void set_options(const DynamicWeightOptions& options) { options_ = options; }
