@@ -261,6 +261,40 @@ TEST(HeadSmootherTest, ExactAgainstBruteForceAndConstraintHolds) {
   }
 }
 
+// Without the constraint (an infinite margin), the exact solution against
+// brute force over a box wide enough to hold the unconstrained optimum; and
+// a target far from C is not pulled into the crop-margin box in one step.
+TEST(HeadSmootherTest, InfiniteMarginDropsTheConstraint) {
+  HeadSmoother hs{HeadSmootherOptions()};
+  const double inf = std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d unbounded(inf, inf);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  for (int trial = 0; trial < 100; ++trial) {
+    const Eigen::Vector2d C(0.5 + u(rng), 0.5 + u(rng));
+    const Eigen::Vector2d Hp = C + Eigen::Vector2d(u(rng), u(rng));
+    const Eigen::Vector2d H = hs.Solve(Hp, C, unbounded);
+    ASSERT_TRUE(H.allFinite());
+    // The optimum lies between C and Hp on each axis.
+    const Eigen::Vector2d lo = C.cwiseMin(Hp), hi = C.cwiseMax(Hp);
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= 400; ++i) {
+      for (int j = 0; j <= 400; ++j) {
+        const Eigen::Vector2d cand(lo.x() + (hi.x() - lo.x()) * i / 400.0,
+                                   lo.y() + (hi.y() - lo.y()) * j / 400.0);
+        best = std::min(best, hs.Objective(cand, Hp, C));
+      }
+    }
+    EXPECT_LE(hs.Objective(H, Hp, C), best + 1e-9) << trial;
+  }
+  // H_prev 0.3 from C, beyond a 0.1 margin: bounded, H must jump into the
+  // box; unbounded, it moves by Eq. 1's own step (w2/d_ref^2 against w1).
+  const Eigen::Vector2d C(0.5, 0.5), Hp(0.8, 0.5), r(0.1, 0.056);
+  EXPECT_LT(hs.Solve(Hp, C, r).x(), 0.6);
+  const double k = 1.0 / (0.03 * 0.03), w1 = 5000.0;
+  EXPECT_NEAR(hs.Solve(Hp, C, unbounded).x(), 0.5 + 0.3 * w1 / (w1 + k), 1e-12);
+}
+
 TEST(HeadSmootherTest, StaysForSmallNoiseFollowsLargeMoves) {
   HeadSmoother hs{HeadSmootherOptions()};
   const Eigen::Vector2d r(0.1, 0.056);

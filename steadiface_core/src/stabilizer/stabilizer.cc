@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -333,7 +334,21 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
       Eigen::Vector2d p;
       H_prev = ProjectFaceCentre(model_, *face, f->rows, f->R_r, R_v0, t0, &p) ? p : f->C;
     }
-    f->H = smoother_.Solve(H_prev, f->C, output_.margin());
+    // Eq. 1's constraint |H - C| < r is a reachability bound when C is in
+    // the real frame (the paper): a crop that moves by at most r can show
+    // the head anywhere within r of where the real camera sees it. With C in
+    // the predicted virtual view, the box around C is not that set, and
+    // clamping H to it drags the target along with every move the margin
+    // forces on the virtual camera, so the head follows the shake it should
+    // have been held against (shake preset: 53.8 -> 49.4 px head jitter
+    // without it; the presets whose margin suffices are unchanged). There,
+    // reachability is left to E_p and the protrusion search, which check it
+    // exactly, rolling shutter included.
+    const double unbounded = std::numeric_limits<double>::infinity();
+    f->H = smoother_.Solve(H_prev, f->C,
+                           options_.smooth_head_in_virtual_view
+                               ? Eigen::Vector2d(unbounded, unbounded)
+                               : output_.margin());
     f->has_target = true;
     f->flags.face_used = use_face && w.fit > 0.0;
     if (use_face) {

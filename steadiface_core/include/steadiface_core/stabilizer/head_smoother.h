@@ -40,7 +40,9 @@ class HeadSmoother {
   explicit HeadSmoother(const HeadSmootherOptions& options)
       : options_(options) {}
 
-  /// One step of Eq. 1. `margin` is r per axis (> 0).
+  /// One step of Eq. 1. `margin` is r per axis (> 0); +infinity drops the
+  /// constraint on that axis (the stabilizer does so when C is in the
+  /// virtual view, where the box is not the reachable set).
   Eigen::Vector2d Solve(const Eigen::Vector2d& previous_target,
                         const Eigen::Vector2d& landmark_centre,
                         const Eigen::Vector2d& margin) const;
