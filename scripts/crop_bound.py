@@ -21,6 +21,15 @@ window with the scorecard's jitter (linear trend removed, FFT bins under
     scripts/crop_bound.py out/eval/traj_run_none.csv [--point head|bg]
         [--frames A:B] (score frames A..B-1 only, e.g. the scorecard's
         longest run of finite samples) [--alpha 0.02]
+        [--feasible out/eval/feasible_run_gyro-only.csv]
+
+With --feasible (written by `steadiface_evaluate --feasible-set`), one more
+row scores the same policies on each frame's measured set of window shifts
+instead of the idealized box: the shifts for which the output is defined with
+the real rotation, rolling shutter included (eval::FeasibleOffsets), given as
+radii in 72 directions. A policy's wanted shift is then projected onto that
+polygon (the closest allowed shift). The zoom is the first --crops value's,
+which must be the crop of the run that wrote the file.
 """
 import argparse
 import csv
@@ -47,6 +56,40 @@ def jitter(A, x):
     return np.sqrt(sum(np.sum((A @ x[:, k]) ** 2) for k in range(2)) / len(x))
 
 
+def polygons(radii):
+    """Per frame, the feasible set's polygon vertices (n, k, 2) [input px]."""
+    k = radii.shape[1]
+    a = 2.0 * np.pi * np.arange(k) / k
+    return radii[:, :, None] * np.stack([np.cos(a), np.sin(a)], axis=1)[None]
+
+
+def project(poly, d):
+    """Closest points of the polygons poly (n, k, 2) to d (n, 2)."""
+    A = poly
+    B = np.roll(poly, -1, axis=1)
+    AB = B - A
+    # Inside: d within the star-shaped polygon around 0 (the sector's
+    # triangle 0, A, B).
+    k = poly.shape[1]
+    ang = np.mod(np.arctan2(d[:, 1], d[:, 0]), 2.0 * np.pi)
+    j = np.minimum((ang / (2.0 * np.pi / k)).astype(int), k - 1)
+    idx = np.arange(len(d))
+    a, b = A[idx, j], B[idx, j]
+    det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ca = (d[:, 0] * b[:, 1] - d[:, 1] * b[:, 0]) / det
+        cb = (a[:, 0] * d[:, 1] - a[:, 1] * d[:, 0]) / det
+    inside = np.isfinite(ca) & np.isfinite(cb) & (ca + cb <= 1.0)
+    # Else the nearest point on the edges.
+    denom = np.maximum((AB ** 2).sum(2), 1e-12)
+    s = np.clip(((d[:, None, :] - A) * AB).sum(2) / denom, 0.0, 1.0)
+    q = A + s[:, :, None] * AB
+    e = ((q - d[:, None, :]) ** 2).sum(2).argmin(1)
+    out = q[idx, e]
+    out[inside] = d[inside]
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("csv")
@@ -56,6 +99,7 @@ def main():
     ap.add_argument("--crops", default="0.1,0.125,0.15,0.2")
     ap.add_argument("--frames", default="", help="A:B, frames scored")
     ap.add_argument("--alpha", type=float, default=0.02)
+    ap.add_argument("--feasible", default="", help="feasible_<preset>_<method>.csv")
     a = ap.parse_args()
     W, H = (float(v) for v in a.size.split("x"))
     keys = ("head_in_x", "head_in_y") if a.point == "head" else ("bg_out_x", "bg_out_y")
@@ -67,9 +111,17 @@ def main():
     mean[0] = x[0]
     for i in range(1, len(x)):
         mean[i] = (1.0 - a.alpha) * mean[i - 1] + a.alpha * x[i]
+    radii = None
+    if a.feasible:
+        with open(a.feasible) as f:
+            radii = np.array([[float(v) for v in list(r.values())[1:]] for r in csv.DictReader(f)])
+        if len(radii) != len(x):
+            raise SystemExit("%s has %d frames, %s %d" % (a.feasible, len(radii), a.csv, len(x)))
     if a.frames:
         lo, hi = (int(v) for v in a.frames.split(":"))
         x, mean = x[lo:hi], mean[lo:hi]
+        if radii is not None:
+            radii = radii[lo:hi]
     n = len(x)
     A = highpass_matrix(n, a.fps, 0.5)
     L = np.linalg.eigvalsh(A.T @ A).max()
@@ -90,6 +142,21 @@ def main():
             best = np.clip(best - (A.T @ (A @ best)) / L, x - M, x + M)
         jc, jr, jo = (zoom * jitter(A, p) for p in (clamp, recentre, best))
         print("| %g %% | %.2f | %.2f | %.2fx | %.2f | %.2fx | %.2f | %.2fx |"
+              % (100 * r, j_in, jc, jc / j_in, jr, jr / j_in, jo, jo / j_in))
+    if radii is not None:
+        r = float(a.crops.split(",")[0])
+        zoom = 1.0 / (1.0 - 2.0 * r)
+        poly = polygons(radii)
+        clamp = np.zeros_like(x)
+        clamp[0] = x[0] + project(poly[:1], np.zeros((1, 2)))[0]
+        for i in range(1, n):
+            clamp[i] = x[i] + project(poly[i:i + 1], (clamp[i - 1] - x[i])[None])[0]
+        recentre = x + project(poly, mean - x)
+        best = clamp.copy()
+        for _ in range(6000):
+            best = x + project(poly, best - (A.T @ (A @ best)) / L - x)
+        jc, jr, jo = (zoom * jitter(A, p) for p in (clamp, recentre, best))
+        print("| %g %%, measured set | %.2f | %.2f | %.2fx | %.2f | %.2fx | %.2f | %.2fx |"
               % (100 * r, j_in, jc, jc / j_in, jr, jr / j_in, jo, jo / j_in))
 
 

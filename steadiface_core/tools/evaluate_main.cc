@@ -22,6 +22,7 @@
 #include <functional>
 #include <memory>
 
+#include "steadiface_core/eval/feasible_offsets.h"
 #include "steadiface_core/eval/ffmpeg_baseline.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/video_scorer.h"
@@ -40,6 +41,32 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
+// Per frame: the time and the radii of eval::FeasibleOffsets in 72
+// directions (5 degrees apart, from +x towards +y) [input px].
+steadiface::Status WriteFeasibleSet(const steadiface::CameraIntrinsics& intrinsics,
+                                    const steadiface::PipelineOptions& po,
+                                    const std::vector<steadiface::StabilizerFrame>& frames,
+                                    const std::string& path) {
+  steadiface::CameraModel model;
+  steadiface::Status s = steadiface::CameraModel::Create(intrinsics, po.camera, &model);
+  steadiface::OutputGeometry output;
+  if (s.ok()) s = steadiface::OutputGeometry::Create(model, po.warp.output, &output);
+  if (!s.ok()) return s;
+  const steadiface::eval::FeasibleOffsets feasible(
+      model, output, po.stabilizer.terms.protrusion_samples_per_edge);
+  std::ofstream csv(path);
+  csv << "t";
+  for (int k = 0; k < 72; ++k) csv << ",r" << 5 * k;
+  csv << "\n";
+  for (const steadiface::StabilizerFrame& f : frames) {
+    csv << steadiface::ToSeconds(f.stamp);
+    for (double r : feasible.Radii(f.rows, f.R_r, 72)) csv << "," << r;
+    csv << "\n";
+  }
+  if (!csv) return steadiface::Status::Error("cannot write " + path);
+  return steadiface::Status::Ok();
+}
+
 int Usage() {
   std::cerr << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
                "       [--methods none,gyro-only,steadiface,steadiface-layered,none/video,\n"
@@ -53,6 +80,9 @@ int Usage() {
                "         at most once per S while no face is locked; 0 = every frame)\n"
                "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
                "         head target's smoothing, Eq. 1)\n"
+               "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
+               "         per frame, the crop-window shifts the margin allows, rolling shutter\n"
+               "         included, in 72 directions [input px], for scripts/crop_bound.py)\n"
                "         (the layered warp's warp/layered/* options, for sweeps)\n";
   return 2;
 }
@@ -77,6 +107,7 @@ int main(int argc, char** argv) {
   double search_interval = NAN;  // face.search_interval [s]; NaN: the default
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
+  bool feasible_set = false;     // --feasible-set: write feasible_<preset>_<method>.csv
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -99,6 +130,7 @@ int main(int argc, char** argv) {
     else if (a == "--search-interval") search_interval = std::atof(next().c_str());
     else if (a == "--head-w-stay") head_w_stay = std::atof(next().c_str());
     else if (a == "--head-d-ref") head_d_ref = std::atof(next().c_str());
+    else if (a == "--feasible-set") feasible_set = true;
     else if (a == "--band") blend.band_width = std::atof(next().c_str());
     else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
     else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
@@ -294,6 +326,10 @@ int main(int argc, char** argv) {
             } else {
               csv << ",nan,nan,nan\n";  // no stabilizer (input)
             }
+          }
+          if (feasible_set && !stab_frames.empty()) {
+            s = WriteFeasibleSet(sim->intrinsics(), po, stab_frames,
+                                 out_dir + "/feasible_" + preset + "_" + name + ".csv");
           }
         }
       }

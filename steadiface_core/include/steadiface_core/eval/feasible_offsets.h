@@ -1,0 +1,42 @@
+#pragma once
+
+#include <vector>
+
+#include "steadiface_core/camera_model.h"
+#include "steadiface_core/output_geometry.h"
+#include "steadiface_core/protrusion.h"
+#include "steadiface_core/row_rotations.h"
+#include "steadiface_core/status.h"
+
+namespace steadiface {
+namespace eval {
+
+/// What the crop margin allows on one frame, whatever the stabilizer: the
+/// principal offsets t for which the output is defined when the virtual
+/// camera keeps the real rotation (R_v = R_r at the middle row), each
+/// boundary sample with its own row's rotation (rolling shutter, as
+/// ProtrusionGeometry checks it). A pure image shift of the crop window, so
+/// it is what a shift-only policy can use (scripts/crop_bound.py --feasible);
+/// a virtual camera that also rotates can reach other poses.
+///
+/// The set is given in polar form: for `directions` evenly spaced angles
+/// (0 = +x, counter-clockwise in image coordinates, i.e. towards +y first)
+/// the largest |t| along that ray with a defined output [input px], found by
+/// bisection to `tolerance_px`. The set contains t = 0 (the real pose) when
+/// the crop fits at all; a frame where even that protrudes gives all 0.
+class FeasibleOffsets {
+ public:
+  FeasibleOffsets(const CameraModel& model, const OutputGeometry& output,
+                  int samples_per_edge);
+
+  /// Radii for one frame's rows (`middle` = the rows' middle rotation).
+  std::vector<double> Radii(const RowRotations& rows, const Eigen::Quaterniond& middle,
+                            int directions, double tolerance_px = 0.05) const;
+
+ private:
+  CameraModel model_;
+  ProtrusionGeometry geometry_;
+};
+
+}  // namespace eval
+}  // namespace steadiface
