@@ -113,6 +113,15 @@ sim::LandmarkSequenceOptions Walk() {
   return o;
 }
 
+// Walking with violent shake (0.03 rad RMS), 3 s: more than RunSequence's
+// 10 % crop can hold.
+sim::LandmarkSequenceOptions ViolentShake() {
+  sim::LandmarkSequenceOptions o = Walk();
+  o.camera.shake_rms_rad = 0.03;
+  o.duration_s = 3.0;
+  return o;
+}
+
 void Print(const char* name, const RunResult& r) {
   std::cout << "[ " << name << " ] head jitter in " << r.input.head_px
             << " px -> " << r.output.head_px << " px; background "
@@ -256,10 +265,7 @@ TEST(StabilizerTest, FaceLossFadesWeightsWithoutJumps) {
 TEST(StabilizerTest, ProtrusionIsRemovedByBinarySearch) {
   const CameraModel m = Model640x360();
   // Violent shake with a tiny crop: the solver alone cannot stay inside.
-  sim::LandmarkSequenceOptions o = Walk();
-  o.camera.shake_rms_rad = 0.03;
-  o.duration_s = 3.0;
-  const sim::LandmarkSequence seq(m, o);
+  const sim::LandmarkSequence seq(m, ViolentShake());
   StabilizerOptions so;
   so.weights.protrusion = 0.0;  // force the post-solve handling to work
   so.weights.follow = 0.01;
@@ -284,10 +290,7 @@ TEST(StabilizerTest, ProtrusionIsRemovedByBinarySearch) {
 // within 3 iterations", which holds only while the margin lasts).
 TEST(StabilizerTest, SolvesConvergeWhereTheMarginRunsOut) {
   const CameraModel m = Model640x360();
-  sim::LandmarkSequenceOptions o = Walk();
-  o.camera.shake_rms_rad = 0.03;
-  o.duration_s = 3.0;
-  const sim::LandmarkSequence seq(m, o);
+  const sim::LandmarkSequence seq(m, ViolentShake());
   auto count = [&](int max_iterations, int* long_solves) {
     StabilizerOptions so;
     so.solver.max_iterations = max_iterations;
