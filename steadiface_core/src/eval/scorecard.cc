@@ -113,11 +113,6 @@ double LineDeviation(const std::vector<Eigen::Vector2d>& pts) {
 
 }  // namespace
 
-double Scorecard::HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
-                              double cutoff_hz) {
-  return steadiface::HighPassRms(x, fps, cutoff_hz);
-}
-
 double Scorecard::Stability(const std::vector<Eigen::Vector2d>& x) {
   if (x.size() < 16) return 0.0;
   double score = 0.0;

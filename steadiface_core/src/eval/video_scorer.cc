@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "steadiface_core/high_pass_rms.h"
 #include "steadiface_core/percentile.h"
 
 namespace steadiface {
@@ -103,7 +104,7 @@ Score VideoScorer::Compute() const {
   const size_t min_run = static_cast<size_t>(std::max(16.0, options_.fps));  // >= 1 s
   const std::vector<Eigen::Vector2d> head = Scorecard::LongestFiniteRun(head_);
   if (head.size() >= min_run) {
-    sc.head_jitter_px = Scorecard::HighPassRms(head, options_.fps, options_.highpass_hz);
+    sc.head_jitter_px = HighPassRms(head, options_.fps, options_.highpass_hz);
     sc.head_stability = Scorecard::Stability(head);
   }
   sc.head_jitter_frac = sc.head_jitter_px / diag;
@@ -111,7 +112,7 @@ Score VideoScorer::Compute() const {
   // (after a break the trajectory restarts from NaN, so runs never mix).
   const std::vector<Eigen::Vector2d> bg = Scorecard::LongestFiniteRun(background_);
   if (bg.size() >= min_run) {
-    sc.background_jitter_px = Scorecard::HighPassRms(bg, options_.fps, options_.highpass_hz);
+    sc.background_jitter_px = HighPassRms(bg, options_.fps, options_.highpass_hz);
     sc.background_stability = Scorecard::Stability(bg);
   }
   sc.background_jitter_frac = sc.background_jitter_px / diag;

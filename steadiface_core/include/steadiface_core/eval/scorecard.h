@@ -130,9 +130,6 @@ class Scorecard {
   };
   const std::vector<Sample>& samples() const { return samples_; }
 
-  /// steadiface::HighPassRms (high_pass_rms.h), under the scorecard's name.
-  static double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
-                            double cutoff_hz);
   /// Liu et al. stability of a 2D trajectory's frame-to-frame motion.
   static double Stability(const std::vector<Eigen::Vector2d>& x);
   /// The longest run of finite samples (jitter needs a contiguous series).
