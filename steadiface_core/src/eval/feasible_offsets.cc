@@ -7,12 +7,12 @@ namespace eval {
 
 FeasibleOffsets::FeasibleOffsets(const CameraModel& model, const OutputGeometry& output,
                                  int samples_per_edge)
-    : model_(model), geometry_(model, output, samples_per_edge) {}
+    : geometry_(model, output, samples_per_edge) {}
 
 std::vector<double> FeasibleOffsets::Radii(const RowRotations& rows,
                                            const Eigen::Quaterniond& middle, int directions,
                                            double tolerance_px) const {
-  const double width = model_.intrinsics().width;
+  const double width = geometry_.model().intrinsics().width;
   std::vector<double> radii(directions > 0 ? directions : 0, 0.0);
   if (!geometry_.Check(middle, Eigen::Vector2d::Zero(), rows, 0.0).defined) return radii;
   for (int k = 0; k < directions; ++k) {

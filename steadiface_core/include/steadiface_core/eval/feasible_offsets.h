@@ -34,7 +34,6 @@ class FeasibleOffsets {
                             int directions, double tolerance_px = 0.05) const;
 
  private:
-  CameraModel model_;
   ProtrusionGeometry geometry_;
 };
 
