@@ -129,36 +129,30 @@ def main():
     print("| crop per side | input px | causal clamp px | vs input | causal recentre px | vs input "
           "| non-causal optimum px | vs input |")
     print("|---|---|---|---|---|---|---|---|")
+    def row(label, r, allowed, iterations):
+        """One table row: the three policies, each wanted shift d (window
+        shift, input px) replaced by allowed(d, frames), the closest one the
+        margin allows on those frames."""
+        clamp = np.zeros_like(x)
+        clamp[0] = x[0] + allowed(np.zeros((1, 2)), slice(0, 1))[0]
+        for i in range(1, n):
+            clamp[i] = x[i] + allowed((clamp[i - 1] - x[i])[None], slice(i, i + 1))[0]
+        recentre = x + allowed(mean - x, slice(None))
+        best = clamp.copy()
+        for _ in range(iterations):
+            best = x + allowed(best - (A.T @ (A @ best)) / L - x, slice(None))
+        zoom = 1.0 / (1.0 - 2.0 * r)
+        jc, jr, jo = (zoom * jitter(A, p) for p in (clamp, recentre, best))
+        print("| %s | %.2f | %.2f | %.2fx | %.2f | %.2fx | %.2f | %.2fx |"
+              % (label, j_in, jc, jc / j_in, jr, jr / j_in, jo, jo / j_in))
+
     for r in (float(v) for v in a.crops.split(",")):
         M = np.array([r * W, r * H])
-        zoom = 1.0 / (1.0 - 2.0 * r)
-        clamp = np.zeros_like(x)
-        clamp[0] = x[0]
-        for i in range(1, n):
-            clamp[i] = np.clip(clamp[i - 1], x[i] - M, x[i] + M)
-        recentre = np.clip(mean, x - M, x + M)
-        best = clamp.copy()
-        for _ in range(20000):
-            best = np.clip(best - (A.T @ (A @ best)) / L, x - M, x + M)
-        jc, jr, jo = (zoom * jitter(A, p) for p in (clamp, recentre, best))
-        print("| %g %% | %.2f | %.2f | %.2fx | %.2f | %.2fx | %.2f | %.2fx |"
-              % (100 * r, j_in, jc, jc / j_in, jr, jr / j_in, jo, jo / j_in))
+        row("%g %%" % (100 * r), r, lambda d, frames: np.clip(d, -M, M), 20000)
     if radii is not None:
         r = float(a.crops.split(",")[0])
-        zoom = 1.0 / (1.0 - 2.0 * r)
         poly = polygons(radii)
-        clamp = np.zeros_like(x)
-        clamp[0] = x[0] + project(poly[:1], np.zeros((1, 2)))[0]
-        for i in range(1, n):
-            clamp[i] = x[i] + project(poly[i:i + 1], (clamp[i - 1] - x[i])[None])[0]
-        recentre = x + project(poly, mean - x)
-        best = clamp.copy()
-        for _ in range(6000):
-            best = x + project(poly, best - (A.T @ (A @ best)) / L - x)
-        jc, jr, jo = (zoom * jitter(A, p) for p in (clamp, recentre, best))
-        print("| %g %%, measured set | %.2f | %.2f | %.2fx | %.2f | %.2fx | %.2f | %.2fx |"
-              % (100 * r, j_in, jc, jc / j_in, jr, jr / j_in, jo, jo / j_in))
-
+        row("%g %%, measured set" % (100 * r), r, lambda d, frames: project(poly[frames], d), 6000)
 
 if __name__ == "__main__":
     main()
