@@ -12,6 +12,7 @@
 
 #include "steadiface_core/so3.h"
 #include "steadiface_core/stabilizer/distortion_cost.h"
+#include "steadiface_core/stabilizer/face_in_camera.h"
 #include "steadiface_core/stabilizer/fitting_cost.h"
 #include "steadiface_core/stabilizer/following_cost.h"
 #include "steadiface_core/stabilizer/protrusion_cost.h"
@@ -58,36 +59,6 @@ double TermEnergy(ceres::Problem* problem,
   double cost = 0.0;
   if (!problem->Evaluate(eo, &cost, nullptr, nullptr, nullptr)) return NAN;
   return 2.0 * cost;
-}
-
-// The landmark centre as the camera (R_v, t) shows it: the mean of the
-// landmarks, each moved through the real rotation of the row it was read on,
-// as E_f moves them. Through the middle row's rotation alone, a face off the
-// middle row would be off by the rotation over the rows between (at 120 deg/s
-// and a 30 ms readout, about 1 deg for a face a quarter frame away), and that
-// error shakes with the camera. Landmarks without rows use the middle row.
-// `scale` (optional): the RMS distance of the moved landmarks to it. False
-// when a landmark lies behind the camera.
-bool ProjectFaceCentre(const CameraModel& model, const FaceObservation& face,
-                       const RowRotations& rows, const Eigen::Quaterniond& R_r_middle,
-                       const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
-                       Eigen::Vector2d* centre, double* scale = nullptr) {
-  std::vector<Eigen::Vector2d> moved(face.landmarks.size());
-  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-  for (size_t i = 0; i < face.landmarks.size(); ++i) {
-    const Eigen::Quaterniond& R_row =
-        face.landmark_rows.empty() ? R_r_middle : rows.At(face.landmark_rows[i]);
-    if (!model.Project(face.landmarks[i], R_v, t, R_row, &moved[i])) return false;
-    sum += moved[i];
-  }
-  if (moved.empty()) return false;
-  *centre = sum / static_cast<double>(moved.size());
-  if (scale != nullptr) {
-    double s2 = 0.0;
-    for (const Eigen::Vector2d& p : moved) s2 += (p - *centre).squaredNorm();
-    *scale = std::sqrt(s2 / moved.size());
-  }
-  return true;
 }
 
 }  // namespace
@@ -166,8 +137,14 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   // A camera fixed in the world at the epoch's first real rotation: what
   // it sees does not depend on where the gyro integration started.
   if (layer.history == 0) R_reference_ = f.R_r;
-  const StabilizerWeights w = DynamicWeightsStep(stamp, timeline, use_face ? face : nullptr, dt,
-                                                 options_.gyro_only, &dynamic_, &f);
+  // The usable face as that camera sees it: the variation measure's input,
+  // and the face held after a loss.
+  FaceObservation world_face;
+  const bool world_ok = use_face && FaceInCamera(model_, *face, f.rows, f.R_r, R_reference_,
+                                                 Eigen::Vector2d::Zero(), &world_face);
+  const StabilizerWeights w =
+      DynamicWeightsStep(stamp, timeline, use_face ? face : nullptr, world_ok ? &world_face : nullptr,
+                         dt, options_.gyro_only, &dynamic_, &f);
 
   Eigen::Quaterniond R_v0;
   Eigen::Vector2d t0;
@@ -176,7 +153,7 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   FaceObservation held;
   const FaceObservation* fit_face = HeldFaceStep(layer, use_face ? face : nullptr, w, &held, &f);
 
-  HeadTargetStep(layer, fit_face, use_face, w, R_v0, t0, &f);
+  HeadTargetStep(layer, fit_face, use_face ? &world_face : nullptr, w, R_v0, t0, &f);
 
   PoseProblem problem;
   Eigen::Quaterniond R_v = R_v0;
@@ -234,7 +211,8 @@ void Stabilizer::StartLayerFrame(const LayerState& layer, Time stamp, Stabilizer
 }
 
 StabilizerWeights Stabilizer::DynamicWeightsStep(Time stamp, const OrientationTimeline& timeline,
-                                                 const FaceObservation* face, double dt,
+                                                 const FaceObservation* face,
+                                                 const FaceObservation* world_face, double dt,
                                                  bool without_fit, DynamicWeights* dynamic,
                                                  StabilizerFrame* f) {
   // Dynamic weights (§4.4). `face` is null unless usable.
@@ -245,15 +223,10 @@ StabilizerWeights Stabilizer::DynamicWeightsStep(Time stamp, const OrientationTi
           &mean_speed)) {
     mean_speed = -1.0;
   }
-  Eigen::Vector2d stabilized_centre = Eigen::Vector2d::Zero();
-  double stabilized_scale = 0.0;
-  if (face != nullptr &&
-      !ProjectFaceCentre(model_, *face, f->rows, f->R_r, R_reference_, Eigen::Vector2d::Zero(),
-                         &stabilized_centre, &stabilized_scale)) {
-    stabilized_centre = face->centre;
-    stabilized_scale = face->scale;
-  }
-  f->factors = dynamic->Update(dt, mean_speed, face, stabilized_centre, stabilized_scale);
+  const FaceObservation* stabilized = world_face != nullptr ? world_face : face;
+  f->factors = dynamic->Update(dt, mean_speed, face,
+                               stabilized ? stabilized->centre : Eigen::Vector2d::Zero(),
+                               stabilized ? stabilized->scale : 0.0);
   StabilizerWeights w = options_.weights;
   w.fit = without_fit ? 0.0 : w.fit * f->factors.fit;
   w.rotation_c0 *= f->factors.smoothness;
@@ -307,7 +280,7 @@ const FaceObservation* Stabilizer::HeldFaceStep(const LayerState& layer,
 }
 
 void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face,
-                                bool use_face, const StabilizerWeights& w,
+                                const FaceObservation* world_face, const StabilizerWeights& w,
                                 const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
                                 StabilizerFrame* f) {
   // Target head centre (Eq. 1).
@@ -324,15 +297,15 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
       const Eigen::Vector2d t_pred = layer.history >= 2
                                          ? Eigen::Vector2d(2.0 * layer.t_prev - layer.t_prev_prev)
                                          : layer.t_prev;
-      Eigen::Vector2d c;
-      if (ProjectFaceCentre(model_, *face, f->rows, f->R_r, R_pred, t_pred, &c)) f->C = c;
+      FaceObservation seen;
+      if (FaceInCamera(model_, *face, f->rows, f->R_r, R_pred, t_pred, &seen)) f->C = seen.centre;
     }
     Eigen::Vector2d H_prev = layer.H_prev;
     if (!layer.has_H) {
       // Start where the face appears in the virtual view now: no jump. (From
       // the landmarks: f->C may already be in the predicted virtual view.)
-      Eigen::Vector2d p;
-      H_prev = ProjectFaceCentre(model_, *face, f->rows, f->R_r, R_v0, t0, &p) ? p : f->C;
+      FaceObservation seen;
+      H_prev = FaceInCamera(model_, *face, f->rows, f->R_r, R_v0, t0, &seen) ? seen.centre : f->C;
     }
     // Eq. 1's constraint |H - C| < r is a reachability bound when C is in
     // the real frame (the paper): a crop that moves by at most r can show
@@ -350,16 +323,10 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
                                ? Eigen::Vector2d(unbounded, unbounded)
                                : output_.margin());
     f->has_target = true;
-    f->flags.face_used = use_face && w.fit > 0.0;
-    if (use_face) {
+    f->flags.face_used = world_face != nullptr && w.fit > 0.0;
+    if (world_face != nullptr) {
       // Hold it as a world-fixed camera sees it.
-      held_face_ = *face;
-      for (size_t i = 0; i < face->landmarks.size(); ++i) {
-        const Eigen::Quaterniond R_row =
-            face->landmark_rows.empty() ? f->R_r : f->rows.At(face->landmark_rows[i]);
-        model_.Project(face->landmarks[i], R_reference_, Eigen::Vector2d::Zero(), R_row,
-                       &held_face_.landmarks[i]);
-      }
+      held_face_ = *world_face;
       has_held_face_ = true;
     }
   }
@@ -564,7 +531,7 @@ void Stabilizer::BackgroundLayer(Time stamp, const OrientationTimeline& timeline
   double dt = 0.0;
   StartLayerFrame(layer, stamp, &b, &dt);
   const StabilizerWeights w =
-      DynamicWeightsStep(stamp, timeline, nullptr, dt, /*without_fit=*/true,
+      DynamicWeightsStep(stamp, timeline, nullptr, nullptr, dt, /*without_fit=*/true,
                          &background_dynamic_, &b);
   Eigen::Quaterniond R_v;
   Eigen::Vector2d t;

@@ -184,11 +184,14 @@ class Stabilizer {
   // previous frame, the first-frame flag.
   void StartLayerFrame(const LayerState& layer, Time stamp, StabilizerFrame* f,
                        double* dt) const;
-  // Dynamic weights (§4.4); `face` is null unless usable.
+  // Dynamic weights (§4.4); `face` is null unless usable, `world_face` (the
+  // face as the reference camera sees it) null unless it could be moved there.
   // `without_fit`: w_f = 0 (gyro-only, or the background layer).
   StabilizerWeights DynamicWeightsStep(Time stamp, const OrientationTimeline& timeline,
-                                       const FaceObservation* face, double dt, bool without_fit,
-                                       DynamicWeights* dynamic, StabilizerFrame* f);
+                                       const FaceObservation* face,
+                                       const FaceObservation* world_face, double dt,
+                                       bool without_fit, DynamicWeights* dynamic,
+                                       StabilizerFrame* f);
   // Initial pose (Eq. 12).
   void InitialPoseStep(const LayerState& layer, const StabilizerFrame& f,
                        Eigen::Quaterniond* R_v0, Eigen::Vector2d* t0) const;
@@ -197,10 +200,13 @@ class Stabilizer {
   const FaceObservation* HeldFaceStep(const LayerState& layer, const FaceObservation* face,
                                       const StabilizerWeights& w, FaceObservation* held,
                                       StabilizerFrame* f);
-  // Head target H (Eq. 1), and the held face updated from a usable one.
-  void HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face, bool use_face,
-                      const StabilizerWeights& w, const Eigen::Quaterniond& R_v0,
-                      const Eigen::Vector2d& t0, StabilizerFrame* f);
+  // Head target H (Eq. 1), and the held face updated from a usable one:
+  // `world_face`, this frame's usable face as the reference camera sees it
+  // (null when there is none).
+  void HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face,
+                      const FaceObservation* world_face, const StabilizerWeights& w,
+                      const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
+                      StabilizerFrame* f);
   // Solve (Eq. 5) from the initial pose in *R_v, *t; the solution replaces
   // it when usable.
   void SolveStep(Time stamp, const OrientationTimeline& timeline, const RowTiming& timing,
