@@ -18,10 +18,17 @@ window with the scorecard's jitter (linear trend removed, FFT bins under
   optimum    non-causal: the window path with the least jitter (projected
              gradient on the convex problem), knowing the whole clip.
 
+With --lookahead K, one more column: the recentre policy given the next K
+frames (K frames of latency). At each frame it picks the points p_i..p_i+K
+that minimize sum |p_j - m_j|^2 + lambda |p_j - p_j-1|^2 (m the running
+mean, --smooth lambda; p_i-1 already shown), each window shift allowed,
+and shows p_i. With lambda 0 it is the recentre policy.
+
     scripts/crop_bound.py out/eval/traj_run_none.csv [--point head|bg]
         [--frames A:B] (score frames A..B-1 only, e.g. the scorecard's
         longest run of finite samples) [--alpha 0.02]
         [--feasible out/eval/feasible_run_gyro-only.csv]
+        [--lookahead K --smooth 0.5]
 
 With --feasible (written by `steadiface_evaluate --feasible-set`), one more
 row scores the same policies on each frame's measured set of window shifts
@@ -100,6 +107,8 @@ def main():
     ap.add_argument("--frames", default="", help="A:B, frames scored")
     ap.add_argument("--alpha", type=float, default=0.02)
     ap.add_argument("--feasible", default="", help="feasible_<preset>_<method>.csv")
+    ap.add_argument("--lookahead", type=int, default=-1, help="K frames known ahead")
+    ap.add_argument("--smooth", type=float, default=0.5, help="lambda of --lookahead")
     a = ap.parse_args()
     W, H = (float(v) for v in a.size.split("x"))
     keys = ("head_in_x", "head_in_y") if a.point == "head" else ("bg_out_x", "bg_out_y")
@@ -126,9 +135,32 @@ def main():
     A = highpass_matrix(n, a.fps, 0.5)
     L = np.linalg.eigvalsh(A.T @ A).max()
     j_in = jitter(A, x)
+    K = a.lookahead
     print("| crop per side | input px | causal clamp px | vs input | causal recentre px | vs input "
-          "| non-causal optimum px | vs input |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| non-causal optimum px | vs input |"
+          + (" recentre, %d-frame lookahead px | vs input |" % K if K >= 0 else ""))
+    print("|---|---|---|---|---|---|---|---|" + ("---|---|" if K >= 0 else ""))
+
+    def lookahead(allowed):
+        """The recentre policy knowing frames i..i+K (projected gradient on
+        each window's convex problem, 300 steps)."""
+        lam = a.smooth
+        p = np.zeros_like(x)
+        for i in range(n):
+            f = slice(i, min(n, i + K + 1))
+            prev = p[i - 1] if i > 0 else None
+            q = x[f] + allowed(mean[f] - x[f], f)
+            for _ in range(300):
+                g = q - mean[f]
+                v = np.diff(q, axis=0)
+                g[1:] += lam * v
+                g[:-1] -= lam * v
+                if prev is not None:
+                    g[0] += lam * (q[0] - prev)
+                q = x[f] + allowed(q - g / (1.0 + 4.0 * lam) - x[f], f)
+            p[i] = q[0]
+        return p
+
     def row(label, r, allowed, iterations):
         """One table row: the three policies, each wanted shift d (window
         shift, input px) replaced by allowed(d, frames), the closest one the
@@ -143,8 +175,12 @@ def main():
             best = x + allowed(best - (A.T @ (A @ best)) / L - x, slice(None))
         zoom = 1.0 / (1.0 - 2.0 * r)
         jc, jr, jo = (zoom * jitter(A, p) for p in (clamp, recentre, best))
-        print("| %s | %.2f | %.2f | %.2fx | %.2f | %.2fx | %.2f | %.2fx |"
-              % (label, j_in, jc, jc / j_in, jr, jr / j_in, jo, jo / j_in))
+        line = ("| %s | %.2f | %.2f | %.2fx | %.2f | %.2fx | %.2f | %.2fx |"
+                % (label, j_in, jc, jc / j_in, jr, jr / j_in, jo, jo / j_in))
+        if K >= 0:
+            jl = zoom * jitter(A, lookahead(allowed))
+            line += " %.2f | %.2fx |" % (jl, jl / j_in)
+        print(line)
 
     for r in (float(v) for v in a.crops.split(",")):
         M = np.array([r * W, r * H])
