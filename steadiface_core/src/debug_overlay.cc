@@ -157,7 +157,7 @@ void DrawLayeredOverlay(const WarpMesh& mesh, const SubjectRegion& region,
   char buf[200];
   std::snprintf(buf, sizeof(buf), "layered g %.2f  offset %.1f->%.1f px  shift %.1f px  cell %.2f%s",
                 region.blend, blend.offset_px, blend.capped_offset_px, blend.shift_px,
-                blend.min_cell_ratio, blend.protrusion_keep < 1.0 ? "  pulled" : "");
+                blend.min_cell_ratio, blend.protrusion_keep * blend.distortion_keep < 1.0 ? "  pulled" : "");
   const cv::Point at(static_cast<int>(8 * s), out->rows - static_cast<int>(10 * s));
   cv::putText(*out, buf, at, cv::FONT_HERSHEY_SIMPLEX, 0.5 * s, cv::Scalar(0, 0, 0), th + 2,
               cv::LINE_AA);

@@ -85,7 +85,8 @@ bool SameLayering(WarpMode mode, const LayeredWarpOptions& a, const WarpOptions&
          ba.band_inside == bb.band_inside && ba.max_offset == bb.max_offset &&
          ba.offset_lowpass_hz == bb.offset_lowpass_hz &&
          ba.band_data_weight == bb.band_data_weight && ba.shape_weight == bb.shape_weight &&
-         ba.temporal_weight == bb.temporal_weight;
+         ba.temporal_weight == bb.temporal_weight &&
+         ba.min_cell_ratio == bb.min_cell_ratio;
 }
 
 Status Warper::Create(const CameraModel& model, const WarpOptions& options,

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "steadiface_core/layered/layer_blend.h"
 #include "steadiface_core/layered/subject_region.h"
@@ -186,6 +187,7 @@ TEST(LayerBlendTest, TheCapBoundsTheOffsetAndTheStretch) {
   LayerBlendOptions capped = NoSlowShift(), uncapped = NoSlowShift();
   capped.max_offset = 0.4;
   uncapped.max_offset = 0.0;
+  capped.min_cell_ratio = uncapped.min_cell_ratio = 0.0;  // the cap alone
   LayerBlend a(g.u, g.v, capped), b(g.u, g.v, uncapped);
   std::vector<Eigen::Vector2f> out_a, out_b;
   LayerBlendReport ra, rb;
@@ -220,6 +222,47 @@ TEST(LayerBlendTest, PullsTowardsTheBackgroundInsteadOfLeavingTheFrame) {
     EXPECT_GE(p.y(), 0.0f);
     EXPECT_LE(p.x(), 639.0f);
     EXPECT_LE(p.y(), 359.0f);
+  }
+}
+
+// No squeezed cell: a layer offset that turns across the band (the subject
+// layer rotated about the head centre, as a violent roll leaves it) has no
+// offset at the head centre for the cap to act on, yet it squeezes the
+// band's cells. The offset is then scaled towards the background layer,
+// as far as the floor requires and no further.
+TEST(LayerBlendTest, PullsTowardsTheBackgroundInsteadOfSqueezingACell) {
+  const Grid g;
+  const auto background = g.Background();
+  const Eigen::Vector2d c = Region().head_centre + Eigen::Vector2d(100, 50);
+  const double a = 35.0 * M_PI / 180.0;
+  const Eigen::Matrix2d R = Eigen::Rotation2Dd(a).toRotationMatrix();
+  std::vector<Eigen::Vector2f> subject(g.n());
+  for (int k = 0; k < g.n(); ++k)
+    subject[k] = (c + R * (background[k].cast<double>() - c)).cast<float>();
+  LayerBlendOptions off = NoSlowShift();
+  off.min_cell_ratio = 0.0;
+  LayerBlend free_blend(g.u, g.v, off), guarded(g.u, g.v, NoSlowShift());
+  std::vector<Eigen::Vector2f> out_free, out;
+  LayerBlendReport rf, rep;
+  // A large input: no vertex leaves it, so only the squeeze can pull.
+  free_blend.Blend(subject, background, Region(), 0.0, 4000, 4000, &out_free,
+                   &rf);
+  guarded.Blend(subject, background, Region(), 0.0, 4000, 4000, &out, &rep);
+  ASSERT_LT(rf.min_cell_ratio, 0.45)
+      << "the case must squeeze without the floor";
+  EXPECT_NEAR(rf.offset_px, 0.0, 0.5);  // nothing at the head centre to cap
+  EXPECT_DOUBLE_EQ(rep.protrusion_keep, 1.0);
+  EXPECT_GT(rep.distortion_keep, 0.05);
+  EXPECT_LT(rep.distortion_keep, 1.0);
+  EXPECT_GE(rep.min_cell_ratio, 0.5 - 1e-3);
+  EXPECT_LT(rep.min_cell_ratio, 0.52);  // pulled only as far as needed
+  EXPECT_EQ(rep.folded_cells, 0);
+  // The same solve, scaled: every vertex at keep of its free offset.
+  for (int k = 0; k < g.n(); ++k) {
+    const Eigen::Vector2f want =
+        background[k] +
+        static_cast<float>(rep.distortion_keep) * (out_free[k] - background[k]);
+    EXPECT_LT((out[k] - want).norm(), 1e-3f) << "vertex " << k;
   }
 }
 
@@ -273,6 +316,12 @@ TEST(LayerBlendTest, RejectsBadOptions) {
   const Status s = ValidateLayerBlendOptions(o);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("max_offset"), std::string::npos) << s.message();
+  o = LayerBlendOptions();
+  o.min_cell_ratio = 1.0;  // no mesh but the background's could pass
+  const Status m = ValidateLayerBlendOptions(o);
+  EXPECT_FALSE(m.ok());
+  EXPECT_NE(m.message().find("min_cell_ratio"), std::string::npos)
+      << m.message();
   SubjectRegionOptions r;
   r.ramp_s = 0.0;
   EXPECT_FALSE(ValidateSubjectRegionOptions(r).ok());

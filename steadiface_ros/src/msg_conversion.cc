@@ -412,7 +412,7 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
     m.layer_offset_px = b.offset_px;
     m.layer_offset_capped_px = b.capped_offset_px;
     m.layer_shift_px = b.shift_px;
-    m.layer_keep = b.protrusion_keep;
+    m.layer_keep = b.protrusion_keep * b.distortion_keep;
     m.min_cell_ratio = b.min_cell_ratio;
     m.folded_cells = static_cast<uint32_t>(std::max(0, b.folded_cells));
   } else {

@@ -317,6 +317,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Num("warp/layered/band_data_weight", &lw.blend.band_data_weight, 1e-6, 1.0);
   r.Num("warp/layered/shape_weight", &lw.blend.shape_weight, 0.0, 1e4);
   r.Num("warp/layered/temporal_weight", &lw.blend.temporal_weight, 0.0, 1e4);
+  r.Num("warp/layered/min_cell_ratio", &lw.blend.min_cell_ratio, 0.0, 0.99);
   r.Num("warp/layered/head_width_scale", &lw.region.head_width_scale, 0.2, 5.0);
   r.Num("warp/layered/head_top_scale", &lw.region.head_top_scale, 0.0, 3.0);
   r.Bool("warp/layered/torso", &lw.region.torso);

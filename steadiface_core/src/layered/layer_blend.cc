@@ -55,6 +55,9 @@ Status ValidateLayerBlendOptions(const LayerBlendOptions& o) {
     err << "warp.layered.offset_lowpass_hz must be in [0, 10] Hz (0 = off), "
            "got "
         << o.offset_lowpass_hz;
+  } else if (!in(o.min_cell_ratio, 0.0, 0.99)) {
+    err << "warp.layered.min_cell_ratio must be in [0, 0.99] (0 = off), got "
+        << o.min_cell_ratio;
   } else if (!in(o.band_data_weight, 1e-6, 1.0) ||
              !in(o.shape_weight, 0.0, 1e4) ||
              !in(o.temporal_weight, 0.0, 1e4)) {
@@ -305,6 +308,37 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     d *= keep;
   }
   r.protrusion_keep = keep;
+  // No squeezed cell: scale d further towards the background layer while a
+  // cell's ratio is below the floor (or below the background's own ratio
+  // for that cell, where that is lower already). At scale 0 every cell is
+  // the background's, so the bisection's lower end is always allowed.
+  if (options_.min_cell_ratio > 0.0) {
+    std::vector<double> floor_ratio;
+    CellRatios(cols_, rows_, u_, v_, background, nullptr, &floor_ratio);
+    for (double& q : floor_ratio) q = std::min(q, options_.min_cell_ratio);
+    std::vector<Eigen::Vector2f> scaled(n);
+    std::vector<double> ratios;
+    auto unsqueezed = [&](double s) {
+      for (int k = 0; k < n; ++k) {
+        scaled[k] = (background[k].cast<double>() + s * d.segment<2>(2 * k))
+                        .cast<float>();
+      }
+      CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &ratios);
+      for (size_t q = 0; q < ratios.size(); ++q) {
+        if (ratios[q] < floor_ratio[q] - 1e-4) return false;
+      }
+      return true;
+    };
+    if (!unsqueezed(1.0)) {
+      double lo = 0.0, hi = 1.0;
+      for (int it = 0; it < 12; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (unsqueezed(mid) ? lo : hi) = mid;
+      }
+      r.distortion_keep = lo;
+      d *= lo;
+    }
+  }
   // Band vertex flicker, then the final mesh.
   double step2 = 0.0;
   int band = 0;

@@ -43,6 +43,13 @@ struct LayerBlendOptions {
   double shape_weight = 1.0;
   /// Temporal smoothness of the vertex offsets between frames [-].
   double temporal_weight = 0.05;
+  /// Least singular-value ratio a cell of the joined mesh may have, or the
+  /// background layer's own ratio for that cell if lower (the blend must
+  /// not squeeze a cell below this). Where the cap is not enough (a layer
+  /// offset that turns or shears across the band, as under violent shake),
+  /// the offset is scaled towards the background layer by bisection, as
+  /// for protrusion [0-1). 0 = off.
+  double min_cell_ratio = 0.5;
 };
 
 Status ValidateLayerBlendOptions(const LayerBlendOptions& options);
@@ -60,6 +67,9 @@ struct LayerBlendReport {
   double offset_px = 0.0, capped_offset_px = 0.0, shift_px = 0.0;
   /// Fraction of the offset kept after the protrusion pull [0-1] (1 = none).
   double protrusion_keep = 1.0;
+  /// Fraction of the offset kept after the distortion pull (min_cell_ratio),
+  /// of what the protrusion pull kept [0-1] (1 = none).
+  double distortion_keep = 1.0;
   /// Worst (smallest) and 1st-percentile singular-value ratio of the cells'
   /// local maps, and cells whose orientation flipped (fold-over).
   double min_cell_ratio = 1.0, p01_cell_ratio = 1.0;
@@ -100,7 +110,10 @@ struct LayerBlendReport {
 /// Then no undefined pixels: every final vertex must land inside the input
 /// frame (the cells are bilinear, so the whole cell then does); otherwise d
 /// is scaled towards 0 (the background layer, already protrusion-free) by
-/// bisection.
+/// bisection. Then no squeezed cell: every cell's singular-value ratio must
+/// be at least min_cell_ratio (or the background layer's own, if lower);
+/// otherwise d is scaled further towards 0 by bisection (a smaller scale
+/// keeps the vertices inside: each vertex's excess is convex in the scale).
 class LayerBlend {
  public:
   /// `u`, `v`: output pixel positions of the vertex columns and rows.
