@@ -37,6 +37,18 @@ the real rotation, rolling shutter included (eval::FeasibleOffsets), given as
 radii in 72 directions. A policy's wanted shift is then projected onto that
 polygon (the closest allowed shift). The zoom is the first --crops value's,
 which must be the crop of the run that wrote the file.
+
+With --feasible-roll (written by `steadiface_evaluate --feasible-set
+--feasible-roll MAX`), one more row: the same sets for a window that may
+also roll, every 0.025 rad within +-MAX, chosen afresh on every frame. A
+roll moves the head as well (the file gives by how much), so a wanted shift
+is replaced by the closest head position any roll and its allowed shifts
+give. This is an optimistic bound for the virtual camera's third freedom: a
+roll that changes from frame to frame is itself visible shake, and the
+score does not count it. The union of the sets is not convex, so that
+row's non-causal optimum is not computed (-). Each roll's set is the
+star-shaped polygon around the rolled window's unshifted pose; a roll whose
+unshifted window protrudes adds nothing there.
 """
 import argparse
 import csv
@@ -107,6 +119,7 @@ def main():
     ap.add_argument("--frames", default="", help="A:B, frames scored")
     ap.add_argument("--alpha", type=float, default=0.02)
     ap.add_argument("--feasible", default="", help="feasible_<preset>_<method>.csv")
+    ap.add_argument("--feasible-roll", default="", help="feasible_<preset>_<method>_roll.csv")
     ap.add_argument("--lookahead", type=int, default=-1, help="K frames known ahead")
     ap.add_argument("--smooth", type=float, default=0.5, help="lambda of --lookahead")
     a = ap.parse_args()
@@ -126,11 +139,25 @@ def main():
             radii = np.array([[float(v) for v in list(r.values())[1:]] for r in csv.DictReader(f)])
         if len(radii) != len(x):
             raise SystemExit("%s has %d frames, %s %d" % (a.feasible, len(radii), a.csv, len(x)))
+    rolls = []  # (head shift (n, 2), polygons (n, k, 2)) per roll
+    if a.feasible_roll:
+        with open(a.feasible_roll) as f:
+            rows = list(csv.DictReader(f))
+        for roll in sorted({r["roll"] for r in rows}, key=float):
+            sel = [r for r in rows if r["roll"] == roll]
+            if len(sel) != len(x):
+                raise SystemExit("%s has %d frames at roll %s, %s %d"
+                                 % (a.feasible_roll, len(sel), roll, a.csv, len(x)))
+            shift = np.array([[float(r["head_dx"]), float(r["head_dy"])] for r in sel])
+            r_k = np.array([[float(v) for v in list(r.values())[4:]] for r in sel])
+            rolls.append((np.nan_to_num(shift), polygons(r_k)))
+        max_roll = max(abs(float(r["roll"])) for r in rows)
     if a.frames:
         lo, hi = (int(v) for v in a.frames.split(":"))
         x, mean = x[lo:hi], mean[lo:hi]
         if radii is not None:
             radii = radii[lo:hi]
+        rolls = [(sh[lo:hi], po[lo:hi]) for sh, po in rolls]
     n = len(x)
     A = highpass_matrix(n, a.fps, 0.5)
     L = np.linalg.eigvalsh(A.T @ A).max()
@@ -161,7 +188,7 @@ def main():
             p[i] = q[0]
         return p
 
-    def row(label, r, allowed, iterations):
+    def row(label, r, allowed, iterations, optimum=True):
         """One table row: the three policies, each wanted shift d (window
         shift, input px) replaced by allowed(d, frames), the closest one the
         margin allows on those frames."""
@@ -171,12 +198,12 @@ def main():
             clamp[i] = x[i] + allowed((clamp[i - 1] - x[i])[None], slice(i, i + 1))[0]
         recentre = x + allowed(mean - x, slice(None))
         best = clamp.copy()
-        for _ in range(iterations):
+        for _ in range(iterations if optimum else 0):
             best = x + allowed(best - (A.T @ (A @ best)) / L - x, slice(None))
         zoom = 1.0 / (1.0 - 2.0 * r)
         jc, jr, jo = (zoom * jitter(A, p) for p in (clamp, recentre, best))
-        line = ("| %s | %.2f | %.2f | %.2fx | %.2f | %.2fx | %.2f | %.2fx |"
-                % (label, j_in, jc, jc / j_in, jr, jr / j_in, jo, jo / j_in))
+        line = ("| %s | %.2f | %.2f | %.2fx | %.2f | %.2fx | " % (label, j_in, jc, jc / j_in, jr, jr / j_in)
+                + ("%.2f | %.2fx |" % (jo, jo / j_in) if optimum else "- | - |"))
         if K >= 0:
             jl = zoom * jitter(A, lookahead(allowed))
             line += " %.2f | %.2fx |" % (jl, jl / j_in)
@@ -189,6 +216,24 @@ def main():
         r = float(a.crops.split(",")[0])
         poly = polygons(radii)
         row("%g %%, measured set" % (100 * r), r, lambda d, frames: project(poly[frames], d), 6000)
+    if rolls:
+        r = float(a.crops.split(",")[0])
+
+        def rolled(d, frames):
+            """The closest head move to d that some roll and its shifts allow."""
+            best, cost = None, None
+            for shift, poly in rolls:
+                q = shift[frames] + project(poly[frames], d - shift[frames])
+                c = ((q - d) ** 2).sum(1)
+                if best is None:
+                    best, cost = q, c
+                else:
+                    better = c < cost
+                    best[better], cost[better] = q[better], c[better]
+            return best
+
+        row("%g %%, measured set, rolling +-%g rad" % (100 * r, max_roll), r, rolled, 0,
+            optimum=False)
 
 if __name__ == "__main__":
     main()

@@ -86,5 +86,45 @@ TEST(FeasibleOffsetsTest, TheMarginsBoxAndWhatRollingShutterSkewTakes) {
   EXPECT_LT(skewed[0] + skewed[4], 2.0 * mx - skew_px);
 }
 
+// A window that also rolls (crop_bound.py --feasible-roll): on a still
+// global-shutter frame a roll is an in-plane rotation about the principal
+// point. A pixel 100 px right of it moves by (100 (cos a - 1), 100 sin a);
+// the rolled 448 x 252 px window's extent is then a cos + b sin per axis, so
+// its room is the frame's half size less that, in closed form.
+TEST(FeasibleOffsetsTest, ARolledWindowIsTheBoxRotatedAboutThePrincipalPoint) {
+  const CameraModel m = testing_util::Model640x360();
+  OutputOptions oo;
+  oo.crop_ratio = 0.15;
+  OutputGeometry og;
+  ASSERT_TRUE(OutputGeometry::Create(m, oo, &og).ok());
+  const eval::FeasibleOffsets feasible(m, og, 8);
+  const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
+  const RowRotations still(I, 360);
+  const CameraIntrinsics& k = m.intrinsics();
+  const double roll = 0.05;
+  Eigen::Vector2d shift;
+  ASSERT_TRUE(feasible.RollShift(still, I, roll,
+                                 Eigen::Vector2d(k.cx + 100.0, k.cy), &shift));
+  EXPECT_NEAR(shift.x(), 100.0 * (std::cos(roll) - 1.0), 1e-6);
+  EXPECT_NEAR(shift.y(), 100.0 * std::sin(roll), 1e-6);
+  ASSERT_TRUE(
+      feasible.RollShift(still, I, roll, Eigen::Vector2d(k.cx, k.cy), &shift));
+  EXPECT_NEAR(shift.norm(), 0.0, 1e-9);
+  // Roll 0 is the unrolled set.
+  EXPECT_EQ(feasible.Radii(still, eval::FeasibleOffsets::Rolled(I, 0.0), 8),
+            feasible.Radii(still, I, 8));
+  const std::vector<double> rolled =
+      feasible.Radii(still, eval::FeasibleOffsets::Rolled(I, roll), 8);
+  const double a = 0.35 * 640, b = 0.35 * 360;  // the window's half size [px]
+  const double room_x =
+      320.0 - (a * std::cos(roll) + b * std::sin(roll));  // 89.98 px
+  const double room_y =
+      180.0 - (a * std::sin(roll) + b * std::cos(roll));  // 42.96 px
+  EXPECT_NEAR(rolled[0], room_x, 1.0);
+  EXPECT_NEAR(rolled[4], room_x, 1.0);
+  EXPECT_NEAR(rolled[2], room_y, 1.0);
+  EXPECT_NEAR(rolled[6], room_y, 1.0);
+}
+
 }  // namespace
 }  // namespace steadiface

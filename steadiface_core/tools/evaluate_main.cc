@@ -43,10 +43,12 @@ std::vector<std::string> Split(const std::string& s) {
 
 // Per frame: the time and the radii of eval::FeasibleOffsets in 72
 // directions (5 degrees apart, from +x towards +y) [input px].
-steadiface::Status WriteFeasibleSet(const steadiface::CameraIntrinsics& intrinsics,
-                                    const steadiface::PipelineOptions& po,
-                                    const std::vector<steadiface::StabilizerFrame>& frames,
-                                    const std::string& path) {
+steadiface::Status WriteFeasibleSet(
+    const steadiface::CameraIntrinsics& intrinsics,
+    const steadiface::PipelineOptions& po,
+    const std::vector<steadiface::StabilizerFrame>& frames,
+    const std::string& path, const std::vector<Eigen::Vector2d>& heads,
+    double max_roll) {
   steadiface::CameraModel model;
   steadiface::Status s = steadiface::CameraModel::Create(intrinsics, po.camera, &model);
   steadiface::OutputGeometry output;
@@ -64,26 +66,74 @@ steadiface::Status WriteFeasibleSet(const steadiface::CameraIntrinsics& intrinsi
     csv << "\n";
   }
   if (!csv) return steadiface::Status::Error("cannot write " + path);
+  if (!(max_roll > 0.0)) return steadiface::Status::Ok();
+  // With --feasible-roll: the same per frame for a window that also rolls,
+  // every 0.025 rad within +-max_roll, and where the true head moves when it
+  // does (NaN where it cannot be projected), one row per frame and roll.
+  const std::string roll_path = path.substr(0, path.size() - 4) + "_roll.csv";
+  std::ofstream rc(roll_path);
+  rc << "t,roll,head_dx,head_dy";
+  for (int k = 0; k < 72; ++k) rc << ",r" << 5 * k;
+  rc << "\n";
+  const int steps = static_cast<int>(std::floor(max_roll / 0.025 + 1e-9));
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const steadiface::StabilizerFrame& f = frames[i];
+    for (int j = -steps; j <= steps; ++j) {
+      const double roll = 0.025 * j;
+      Eigen::Vector2d shift(NAN, NAN);
+      if (i < heads.size() && heads[i].allFinite() &&
+          !feasible.RollShift(f.rows, f.R_r, roll, heads[i], &shift)) {
+        shift = Eigen::Vector2d(NAN, NAN);
+      }
+      rc << steadiface::ToSeconds(f.stamp) << "," << roll << "," << shift.x()
+         << "," << shift.y();
+      for (double r : feasible.Radii(
+               f.rows, steadiface::eval::FeasibleOffsets::Rolled(f.R_r, roll),
+               72)) {
+        rc << "," << r;
+      }
+      rc << "\n";
+    }
+  }
+  if (!rc) return steadiface::Status::Error("cannot write " + roll_path);
   return steadiface::Status::Ok();
 }
 
 int Usage() {
-  std::cerr << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
-               "       [--methods none,gyro-only,steadiface,steadiface-layered,none/video,\n"
-               "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
-               "       [--size WxH] [--seed N] [--render] [--crop R]\n"
-               "       [--band W] [--band-inside F] [--max-offset C] [--offset-lowpass HZ]\n"
-               "       [--offset-error S] [--readout-error S] (misconfigure the IMU timing)\n"
-               "       [--gyro-scale K] [--gyro-speed K] (presets with the recorded gyro\n"
-               "         trace: scale its rotation, or play it K times as fast)\n"
-               "       [--search-interval S] (face.search_interval: full-frame face search\n"
-               "         at most once per S while no face is locked; 0 = every frame)\n"
-               "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
-               "         head target's smoothing, Eq. 1)\n"
-               "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
-               "         per frame, the crop-window shifts the margin allows, rolling shutter\n"
-               "         included, in 72 directions [input px], for scripts/crop_bound.py)\n"
-               "         (the layered warp's warp/layered/* options, for sweeps)\n";
+  std::cerr
+      << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
+         "       [--methods "
+         "none,gyro-only,steadiface,steadiface-layered,none/video,\n"
+         "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration "
+         "S]\n"
+         "       [--size WxH] [--seed N] [--render] [--crop R]\n"
+         "       [--band W] [--band-inside F] [--max-offset C] "
+         "[--offset-lowpass HZ]\n"
+         "       [--offset-error S] [--readout-error S] (misconfigure the IMU "
+         "timing)\n"
+         "       [--gyro-scale K] [--gyro-speed K] (presets with the recorded "
+         "gyro\n"
+         "         trace: scale its rotation, or play it K times as fast)\n"
+         "       [--search-interval S] (face.search_interval: full-frame face "
+         "search\n"
+         "         at most once per S while no face is locked; 0 = every "
+         "frame)\n"
+         "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: "
+         "the\n"
+         "         head target's smoothing, Eq. 1)\n"
+         "       [--feasible-set] (per stabilizer method also "
+         "feasible_<preset>_<method>.csv:\n"
+         "         per frame, the crop-window shifts the margin allows, "
+         "rolling shutter\n"
+         "         included, in 72 directions [input px], for "
+         "scripts/crop_bound.py)\n"
+         "       [--feasible-roll MAX] (with --feasible-set, also "
+         "feasible_<preset>_<method>_roll.csv:\n"
+         "         the same for a window that also rolls, every 0.025 rad "
+         "within +-MAX,\n"
+         "         and the true head's move when it does; crop_bound.py "
+         "--feasible-roll)\n"
+         "         (the layered warp's warp/layered/* options, for sweeps)\n";
   return 2;
 }
 
@@ -108,6 +158,8 @@ int main(int argc, char** argv) {
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
   bool feasible_set = false;     // --feasible-set: write feasible_<preset>_<method>.csv
+  double feasible_roll =
+      0.0;  // --feasible-roll: also ..._roll.csv within +-this [rad]
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -131,6 +183,8 @@ int main(int argc, char** argv) {
     else if (a == "--head-w-stay") head_w_stay = std::atof(next().c_str());
     else if (a == "--head-d-ref") head_d_ref = std::atof(next().c_str());
     else if (a == "--feasible-set") feasible_set = true;
+    else if (a == "--feasible-roll")
+      feasible_roll = std::atof(next().c_str());
     else if (a == "--band") blend.band_width = std::atof(next().c_str());
     else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
     else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
@@ -328,8 +382,12 @@ int main(int argc, char** argv) {
             }
           }
           if (feasible_set && !stab_frames.empty()) {
-            s = WriteFeasibleSet(sim->intrinsics(), po, stab_frames,
-                                 out_dir + "/feasible_" + preset + "_" + name + ".csv");
+            std::vector<Eigen::Vector2d> heads;  // the true head in the input
+            for (const auto& p : card->samples()) heads.push_back(p.head_in);
+            s = WriteFeasibleSet(
+                sim->intrinsics(), po, stab_frames,
+                out_dir + "/feasible_" + preset + "_" + name + ".csv", heads,
+                feasible_roll);
           }
         }
       }

@@ -1,6 +1,9 @@
 #include "steadiface_core/eval/feasible_offsets.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include <Eigen/Geometry>
 
 namespace steadiface {
 namespace eval {
@@ -27,6 +30,36 @@ std::vector<double> FeasibleOffsets::Radii(const RowRotations& rows,
     radii[k] = lo * width;
   }
   return radii;
+}
+
+Eigen::Quaterniond FeasibleOffsets::Rolled(const Eigen::Quaterniond& middle,
+                                           double roll) {
+  return (Eigen::Quaterniond(
+              Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ())) *
+          middle)
+      .normalized();
+}
+
+bool FeasibleOffsets::RollShift(const RowRotations& rows,
+                                const Eigen::Quaterniond& middle, double roll,
+                                const Eigen::Vector2d& pixel,
+                                Eigen::Vector2d* shift) const {
+  const CameraModel& model = geometry_.model();
+  const int last_row = model.intrinsics().height - 1;
+  const Eigen::Quaterniond R_row =
+      rows.At(std::max(0.0, std::min<double>(last_row, pixel.y())));
+  const Eigen::Vector2d L = model.PixelToNormalized(pixel);
+  Eigen::Vector2d rolled, kept;
+  if (!model.Project(L, Rolled(middle, roll), Eigen::Vector2d::Zero(), R_row,
+                     &rolled) ||
+      !model.Project(L, middle, Eigen::Vector2d::Zero(), R_row, &kept)) {
+    return false;
+  }
+  // Normalized units are fractions of the width, in the virtual camera's
+  // scale; input px at f_v / f_r = 1 (the output's zoom is the crop's).
+  *shift = (rolled - kept) * model.intrinsics().width * model.real_focal() /
+           model.virtual_focal();
+  return shift->allFinite();
 }
 
 }  // namespace eval

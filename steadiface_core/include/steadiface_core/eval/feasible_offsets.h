@@ -29,9 +29,26 @@ class FeasibleOffsets {
   FeasibleOffsets(const CameraModel& model, const OutputGeometry& output,
                   int samples_per_edge);
 
-  /// Radii for one frame's rows (`middle` = the rows' middle rotation).
+  /// Radii for one frame's rows (`middle` = the virtual rotation at t = 0:
+  /// the rows' middle rotation, or Rolled() of it).
   std::vector<double> Radii(const RowRotations& rows, const Eigen::Quaterniond& middle,
                             int directions, double tolerance_px = 0.05) const;
+
+  /// The virtual rotation that keeps the real one but rolls by `roll` [rad]
+  /// about the optical axis: R_v = Rz(roll) R_r (R_v world -> virtual).
+  /// With it Radii() gives the set of a window that also rolls: an upper
+  /// bound on what the virtual camera's third freedom adds to a shift
+  /// (scripts/crop_bound.py --feasible-roll).
+  static Eigen::Quaterniond Rolled(const Eigen::Quaterniond& middle,
+                                   double roll);
+
+  /// Where the real pixel `pixel` (read at its own row) moves in the view
+  /// when the virtual camera rolls by `roll` [rad] instead of keeping the
+  /// real rotation, both at t = 0 [input px]. False when the point cannot be
+  /// projected.
+  bool RollShift(const RowRotations& rows, const Eigen::Quaterniond& middle,
+                 double roll, const Eigen::Vector2d& pixel,
+                 Eigen::Vector2d* shift) const;
 
  private:
   ProtrusionGeometry geometry_;
