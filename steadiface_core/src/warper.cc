@@ -77,16 +77,21 @@ bool SameLayering(WarpMode mode, const LayeredWarpOptions& a, const WarpOptions&
   const LayeredWarpOptions& b = options.layered;
   const SubjectRegionOptions &ra = a.region, &rb = b.region;
   const LayerBlendOptions &ba = a.blend, &bb = b.blend;
-  return mode == options.mode && a.mesh_cols == b.mesh_cols && a.mesh_rows == b.mesh_rows &&
-         ra.head_width_scale == rb.head_width_scale && ra.head_top_scale == rb.head_top_scale &&
-         ra.torso == rb.torso && ra.shoulder_width_scale == rb.shoulder_width_scale &&
-         ra.neck_width_scale == rb.neck_width_scale && ra.smoothing_s == rb.smoothing_s &&
-         ra.ramp_s == rb.ramp_s && ba.band_width == bb.band_width &&
-         ba.band_inside == bb.band_inside && ba.max_offset == bb.max_offset &&
+  return mode == options.mode && a.mesh_cols == b.mesh_cols &&
+         a.mesh_rows == b.mesh_rows &&
+         ra.head_width_scale == rb.head_width_scale &&
+         ra.head_top_scale == rb.head_top_scale && ra.torso == rb.torso &&
+         ra.shoulder_width_scale == rb.shoulder_width_scale &&
+         ra.neck_width_scale == rb.neck_width_scale &&
+         ra.smoothing_s == rb.smoothing_s && ra.ramp_s == rb.ramp_s &&
+         ba.band_width == bb.band_width && ba.band_inside == bb.band_inside &&
+         ba.max_offset == bb.max_offset &&
          ba.offset_lowpass_hz == bb.offset_lowpass_hz &&
-         ba.band_data_weight == bb.band_data_weight && ba.shape_weight == bb.shape_weight &&
+         ba.band_data_weight == bb.band_data_weight &&
+         ba.shape_weight == bb.shape_weight &&
          ba.temporal_weight == bb.temporal_weight &&
-         ba.min_cell_ratio == bb.min_cell_ratio;
+         ba.min_cell_ratio == bb.min_cell_ratio &&
+         ba.yield_to_subject == bb.yield_to_subject;
 }
 
 Status Warper::Create(const CameraModel& model, const WarpOptions& options,

@@ -58,6 +58,12 @@ LayerBlendOptions NoSlowShift() {
   return o;
 }
 
+// The background-first variant (the subject gives way).
+LayerBlendOptions YieldingToTheBackground(LayerBlendOptions o) {
+  o.yield_to_subject = false;
+  return o;
+}
+
 std::vector<Eigen::Vector2f> Shifted(const std::vector<Eigen::Vector2f>& b,
                                      const Eigen::Vector2d& T) {
   std::vector<Eigen::Vector2f> s = b;
@@ -184,7 +190,8 @@ TEST(LayerBlendTest, TheCapBoundsTheOffsetAndTheStretch) {
   const Grid g;
   const auto background = g.Background();
   const auto subject = Shifted(background, Eigen::Vector2d(60.0, 0.0));
-  LayerBlendOptions capped = NoSlowShift(), uncapped = NoSlowShift();
+  LayerBlendOptions capped = YieldingToTheBackground(NoSlowShift()),
+                    uncapped = YieldingToTheBackground(NoSlowShift());
   capped.max_offset = 0.4;
   uncapped.max_offset = 0.0;
   capped.min_cell_ratio = uncapped.min_cell_ratio = 0.0;  // the cap alone
@@ -200,6 +207,25 @@ TEST(LayerBlendTest, TheCapBoundsTheOffsetAndTheStretch) {
   EXPECT_NEAR((out_a[centre] - background[centre]).x(), 20.0, 1e-3);
   EXPECT_GT(ra.min_cell_ratio, rb.min_cell_ratio + 0.1);
   EXPECT_EQ(ra.folded_cells, 0);
+  // Yielding to the subject, the rest of the offset (60 - 20 px) shifts the
+  // whole frame instead: the core follows the subject layer exactly, the
+  // far background moves by 40 px, and the band bends exactly as much as
+  // the capped band above (the same mesh plus a translation).
+  LayerBlendOptions yielding = capped;
+  yielding.yield_to_subject = true;
+  LayerBlend c(g.u, g.v, yielding);
+  std::vector<Eigen::Vector2f> out_c;
+  LayerBlendReport rc;
+  c.Blend(subject, background, Region(), 0.0, 840, 460, &out_c, &rc);
+  EXPECT_NEAR(rc.capped_offset_px, 0.4 * 50, 1e-6);
+  EXPECT_NEAR((out_c[centre] - background[centre]).x(), 60.0, 1e-3);
+  EXPECT_NEAR((out_c[0] - background[0]).x(), 40.0, 1e-3);  // a corner
+  for (int k = 0; k < g.n(); ++k) {
+    const Eigen::Vector2f moved = out_a[k] + Eigen::Vector2f(40.0f, 0.0f);
+    EXPECT_LT((out_c[k] - moved).norm(), 1e-3f) << "vertex " << k;
+  }
+  EXPECT_NEAR(rc.min_cell_ratio, ra.min_cell_ratio, 1e-4);  // float mesh
+  EXPECT_DOUBLE_EQ(rc.protrusion_keep, 1.0);
 }
 
 // No undefined pixels: when the subject layer would pull vertices out of
@@ -212,7 +238,7 @@ TEST(LayerBlendTest, PullsTowardsTheBackgroundInsteadOfLeavingTheFrame) {
   for (int k = 0; k < g.n(); ++k) background[k] = g.At(k).cast<float>();
   const auto subject = Shifted(
       background, Eigen::Vector2d(0.0, 15.0));  // shoulders off the bottom
-  LayerBlend blend(g.u, g.v, NoSlowShift());
+  LayerBlend blend(g.u, g.v, YieldingToTheBackground(NoSlowShift()));
   std::vector<Eigen::Vector2f> out;
   LayerBlendReport rep;
   blend.Blend(subject, background, Region(), 0.0, 640, 360, &out, &rep);
@@ -239,9 +265,10 @@ TEST(LayerBlendTest, PullsTowardsTheBackgroundInsteadOfSqueezingACell) {
   std::vector<Eigen::Vector2f> subject(g.n());
   for (int k = 0; k < g.n(); ++k)
     subject[k] = (c + R * (background[k].cast<double>() - c)).cast<float>();
-  LayerBlendOptions off = NoSlowShift();
+  LayerBlendOptions off = YieldingToTheBackground(NoSlowShift());
   off.min_cell_ratio = 0.0;
-  LayerBlend free_blend(g.u, g.v, off), guarded(g.u, g.v, NoSlowShift());
+  LayerBlend free_blend(g.u, g.v, off),
+      guarded(g.u, g.v, YieldingToTheBackground(NoSlowShift()));
   std::vector<Eigen::Vector2f> out_free, out;
   LayerBlendReport rf, rep;
   // A large input: no vertex leaves it, so only the squeeze can pull.
@@ -263,6 +290,93 @@ TEST(LayerBlendTest, PullsTowardsTheBackgroundInsteadOfSqueezingACell) {
         background[k] +
         static_cast<float>(rep.distortion_keep) * (out_free[k] - background[k]);
     EXPECT_LT((out[k] - want).norm(), 1e-3f) << "vertex " << k;
+  }
+}
+
+// Yielding to the subject, the same squeeze is pulled towards the subject
+// layer instead (a rotated grid: every cell's ratio 1): every vertex at the
+// kept fraction of its departure from the subject layer, the floor met
+// and no further, and the head centre exactly where the subject layer has
+// it, whatever the pull.
+TEST(LayerBlendTest, YieldingToTheSubjectPullsTowardsTheSubjectLayer) {
+  const Grid g;
+  const auto background = g.Background();
+  const Eigen::Vector2d c = Region().head_centre + Eigen::Vector2d(100, 50);
+  const Eigen::Matrix2d R =
+      Eigen::Rotation2Dd(35.0 * M_PI / 180.0).toRotationMatrix();
+  std::vector<Eigen::Vector2f> subject(g.n());
+  for (int k = 0; k < g.n(); ++k)
+    subject[k] = (c + R * (background[k].cast<double>() - c)).cast<float>();
+  LayerBlendOptions off = NoSlowShift();
+  off.min_cell_ratio = 0.0;
+  ASSERT_TRUE(off.yield_to_subject) << "the default";
+  LayerBlend free_blend(g.u, g.v, off), guarded(g.u, g.v, NoSlowShift());
+  std::vector<Eigen::Vector2f> out_free, out;
+  LayerBlendReport rf, rep;
+  free_blend.Blend(subject, background, Region(), 0.0, 4000, 4000, &out_free,
+                   &rf);
+  guarded.Blend(subject, background, Region(), 0.0, 4000, 4000, &out, &rep);
+  ASSERT_LT(rf.min_cell_ratio, 0.45);
+  EXPECT_GT(rep.distortion_keep, 0.05);
+  EXPECT_LT(rep.distortion_keep, 1.0);
+  EXPECT_GE(rep.min_cell_ratio, 0.5 - 1e-3);
+  EXPECT_LT(rep.min_cell_ratio, 0.52);
+  EXPECT_EQ(rep.folded_cells, 0);
+  int core = 0;
+  for (int k = 0; k < g.n(); ++k) {
+    const Eigen::Vector2f want =
+        subject[k] +
+        static_cast<float>(rep.distortion_keep) * (out_free[k] - subject[k]);
+    EXPECT_LT((out[k] - want).norm(), 1e-3f) << "vertex " << k;
+    if (guarded.vertex_blend()[k] >= 1.0) {
+      EXPECT_LT((out[k] - subject[k]).norm(), 1e-3f) << "core vertex " << k;
+      ++core;
+    }
+  }
+  EXPECT_GT(core, 20);
+}
+
+// A whole-frame shift that lags behind the layers (the slow part of an
+// offset held for seconds) while the background layer has reached the
+// input's top edge: the frame shifted by it would leave the input.
+// Yielding to the background, the pull drags the head towards the
+// background layer; yielding to the subject, the cap's rest moves the
+// frame with the subject and the head stays exactly on the subject layer,
+// every vertex inside.
+TEST(LayerBlendTest, ALaggingShiftNeverDragsTheHeadWhenYieldingToTheSubject) {
+  const Grid g;
+  std::vector<Eigen::Vector2f> low(g.n()), top(g.n());
+  for (int k = 0; k < g.n(); ++k) {
+    low[k] = (g.At(k) + Eigen::Vector2d(100, 100)).cast<float>();  // bottom
+    top[k] = (g.At(k) + Eigen::Vector2d(100, 0)).cast<float>();    // top edge
+  }
+  const int centre = 9 * 33 + 16;  // in the core
+  for (const bool to_subject : {false, true}) {
+    LayerBlendOptions o;
+    o.yield_to_subject = to_subject;
+    LayerBlend blend(g.u, g.v, o);
+    std::vector<Eigen::Vector2f> out;
+    LayerBlendReport rep;
+    // The subject 60 px above the background for 20 s: the shift learns it.
+    for (int i = 0; i < 600; ++i) {
+      blend.Blend(Shifted(low, {0, -60}), low, Region(), i ? 1.0 / 30 : 0.0,
+                  840, 460, &out, &rep);
+    }
+    ASSERT_NEAR(rep.shift_px, 60.0, 0.5);
+    // Then the background at the top edge, the subject 20 px below it.
+    const auto subject = Shifted(top, {0, 20});
+    blend.Blend(subject, top, Region(), 1.0 / 30, 840, 460, &out, &rep);
+    for (const auto& p : out) {
+      EXPECT_GE(p.y(), -1e-3f);
+      EXPECT_LE(p.y(), 459.0f + 1e-3f);
+    }
+    const double head_error = (out[centre] - subject[centre]).norm();
+    if (to_subject) {
+      EXPECT_LT(head_error, 1e-3);
+    } else {
+      EXPECT_LT(rep.protrusion_keep, 1.0);
+      EXPECT_GT(head_error, 10.0);  // over half way to the background layer
+    }
   }
 }
 

@@ -100,40 +100,29 @@ steadiface::Status WriteFeasibleSet(
 }
 
 int Usage() {
-  std::cerr
-      << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
-         "       [--methods "
-         "none,gyro-only,steadiface,steadiface-layered,none/video,\n"
-         "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration "
-         "S]\n"
-         "       [--size WxH] [--seed N] [--render] [--crop R]\n"
-         "       [--band W] [--band-inside F] [--max-offset C] "
-         "[--offset-lowpass HZ]\n"
-         "       [--offset-error S] [--readout-error S] (misconfigure the IMU "
-         "timing)\n"
-         "       [--gyro-scale K] [--gyro-speed K] (presets with the recorded "
-         "gyro\n"
-         "         trace: scale its rotation, or play it K times as fast)\n"
-         "       [--search-interval S] (face.search_interval: full-frame face "
-         "search\n"
-         "         at most once per S while no face is locked; 0 = every "
-         "frame)\n"
-         "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: "
-         "the\n"
-         "         head target's smoothing, Eq. 1)\n"
-         "       [--feasible-set] (per stabilizer method also "
-         "feasible_<preset>_<method>.csv:\n"
-         "         per frame, the crop-window shifts the margin allows, "
-         "rolling shutter\n"
-         "         included, in 72 directions [input px], for "
-         "scripts/crop_bound.py)\n"
-         "       [--feasible-roll MAX] (with --feasible-set, also "
-         "feasible_<preset>_<method>_roll.csv:\n"
-         "         the same for a window that also rolls, every 0.025 rad "
-         "within +-MAX,\n"
-         "         and the true head's move when it does; crop_bound.py "
-         "--feasible-roll)\n"
-         "         (the layered warp's warp/layered/* options, for sweeps)\n";
+  // clang-format off
+  std::cerr << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
+               "       [--methods none,gyro-only,steadiface,steadiface-layered,none/video,\n"
+               "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
+               "       [--size WxH] [--seed N] [--render] [--crop R]\n"
+               "       [--band W] [--band-inside F] [--max-offset C] [--offset-lowpass HZ]\n"
+               "       [--yield-to-background] (the layered warp's warp/layered/* options,\n"
+               "         for sweeps; the last sets yield_to_subject false)\n"
+               "       [--offset-error S] [--readout-error S] (misconfigure the IMU timing)\n"
+               "       [--gyro-scale K] [--gyro-speed K] (presets with the recorded gyro\n"
+               "         trace: scale its rotation, or play it K times as fast)\n"
+               "       [--search-interval S] (face.search_interval: full-frame face search\n"
+               "         at most once per S while no face is locked; 0 = every frame)\n"
+               "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
+               "         head target's smoothing, Eq. 1)\n"
+               "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
+               "         per frame, the crop-window shifts the margin allows, rolling shutter\n"
+               "         included, in 72 directions [input px], for scripts/crop_bound.py)\n"
+               "       [--feasible-roll MAX] (with --feasible-set, also\n"
+               "         feasible_<preset>_<method>_roll.csv: the same for a window that also\n"
+               "         rolls, every 0.025 rad within +-MAX, and the true head's move when it\n"
+               "         does; for crop_bound.py --feasible-roll)\n";
+  // clang-format on
   return 2;
 }
 
@@ -188,6 +177,8 @@ int main(int argc, char** argv) {
     else if (a == "--band") blend.band_width = std::atof(next().c_str());
     else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
     else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
+    else if (a == "--yield-to-background")
+      blend.yield_to_subject = false;
     else if (a == "--offset-lowpass") blend.offset_lowpass_hz = std::atof(next().c_str());
     else if (a == "--size") {
       if (std::sscanf(next().c_str(), "%dx%d", &width, &height) != 2) return Usage();

@@ -318,6 +318,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Num("warp/layered/shape_weight", &lw.blend.shape_weight, 0.0, 1e4);
   r.Num("warp/layered/temporal_weight", &lw.blend.temporal_weight, 0.0, 1e4);
   r.Num("warp/layered/min_cell_ratio", &lw.blend.min_cell_ratio, 0.0, 0.99);
+  r.Bool("warp/layered/yield_to_subject", &lw.blend.yield_to_subject);
   r.Num("warp/layered/head_width_scale", &lw.region.head_width_scale, 0.2, 5.0);
   r.Num("warp/layered/head_top_scale", &lw.region.head_top_scale, 0.0, 3.0);
   r.Bool("warp/layered/torso", &lw.region.torso);
@@ -393,6 +394,7 @@ void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::WarpMode* mo
   layered->blend.band_inside = c.band_inside;
   layered->blend.max_offset = c.max_offset;
   layered->blend.offset_lowpass_hz = c.offset_lowpass;
+  layered->blend.yield_to_subject = c.yield_to_subject;
   layered->region.head_width_scale = c.head_width_scale;
   layered->region.head_top_scale = c.head_top_scale;
   layered->region.torso = c.torso;
@@ -442,6 +444,7 @@ steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptio
   c.band_inside = w.layered.blend.band_inside;
   c.max_offset = w.layered.blend.max_offset;
   c.offset_lowpass = w.layered.blend.offset_lowpass_hz;
+  c.yield_to_subject = w.layered.blend.yield_to_subject;
   c.head_width_scale = w.layered.region.head_width_scale;
   c.head_top_scale = w.layered.region.head_top_scale;
   c.torso = w.layered.region.torso;

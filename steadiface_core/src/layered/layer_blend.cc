@@ -231,6 +231,12 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   if (max_offset_px > 0 && r.offset_px > max_offset_px)
     cap = max_offset_px / r.offset_px;
   r.capped_offset_px = r.offset_px * cap;
+  // Yielding to the subject, what the cap takes from the band moves the
+  // whole frame instead: the core still follows the subject layer.
+  if (options_.yield_to_subject) {
+    shift += region.blend * (1.0 - cap) * fast;
+    r.shift_px = shift.norm() / in_per_out;
+  }
   // Targets T_k. Vertices in the core and beyond the band are held at
   // their targets (their data terms dominate: they follow their layer);
   // only the band's vertices are unknowns of the least-squares problem
@@ -285,13 +291,26 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
       }
     }  // else (cannot happen for this SPD system) the plain blend T stays
   }
-  // No undefined pixels: scale d towards the background layer if a vertex
-  // leaves the input frame (more than the background's own vertex does).
+  // The pulls below scale d's departure from the layer that does not give
+  // way: d_k = base_k + s (d_k - base_k), with base 0 (the background
+  // layer) or, yielding to the subject, g D_k (the background layer moved
+  // g of the way to the subject layer; with both layers inside the frame,
+  // so is every convex mix of them). At s = 0 the mesh is that layer's.
+  Eigen::VectorXd base = Eigen::VectorXd::Zero(2 * n);
+  if (options_.yield_to_subject) {
+    for (int k = 0; k < n; ++k) {
+      base.segment<2>(2 * k) =
+          region.blend * (subject[k] - background[k]).cast<double>();
+    }
+  }
+  // No undefined pixels: scale d towards the base if a vertex leaves the
+  // input frame (more than the base's own vertex does).
   const double w1 = input_width - 1.0, h1 = input_height - 1.0;
   auto feasible = [&](double s) {
     for (int k = 0; k < n; ++k) {
-      const Eigen::Vector2d bk = background[k].cast<double>();
-      if (Excess(bk + s * d.segment<2>(2 * k), w1, h1) >
+      const Eigen::Vector2d bk =
+          background[k].cast<double>() + base.segment<2>(2 * k);
+      if (Excess(bk + s * (d - base).segment<2>(2 * k), w1, h1) >
           Excess(bk, w1, h1) + 1e-3)
         return false;
     }
@@ -305,7 +324,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
       (feasible(mid) ? lo : hi) = mid;
     }
     keep = lo;
-    d *= keep;
+    d = base + keep * (d - base);
   }
   r.protrusion_keep = keep;
   // No squeezed cell: scale d further towards the background layer while a
@@ -313,14 +332,19 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   // for that cell, where that is lower already). At scale 0 every cell is
   // the background's, so the bisection's lower end is always allowed.
   if (options_.min_cell_ratio > 0.0) {
-    std::vector<double> floor_ratio;
-    CellRatios(cols_, rows_, u_, v_, background, nullptr, &floor_ratio);
-    for (double& q : floor_ratio) q = std::min(q, options_.min_cell_ratio);
     std::vector<Eigen::Vector2f> scaled(n);
+    for (int k = 0; k < n; ++k) {
+      scaled[k] =
+          (background[k].cast<double>() + base.segment<2>(2 * k)).cast<float>();
+    }
+    std::vector<double> floor_ratio;
+    CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &floor_ratio);
+    for (double& q : floor_ratio) q = std::min(q, options_.min_cell_ratio);
     std::vector<double> ratios;
     auto unsqueezed = [&](double s) {
       for (int k = 0; k < n; ++k) {
-        scaled[k] = (background[k].cast<double>() + s * d.segment<2>(2 * k))
+        scaled[k] = (background[k].cast<double>() + base.segment<2>(2 * k) +
+                     s * (d - base).segment<2>(2 * k))
                         .cast<float>();
       }
       CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &ratios);
@@ -336,7 +360,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
         (unsqueezed(mid) ? lo : hi) = mid;
       }
       r.distortion_keep = lo;
-      d *= lo;
+      d = base + lo * (d - base);
     }
   }
   // Band vertex flicker, then the final mesh.
@@ -348,10 +372,10 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
       step2 += (dk - d_previous_.segment<2>(2 * k)).squaredNorm();
       ++band;
     }
-    // Clamp to the frame (or to the background vertex's own excursion):
-    // removes rounding, never moves a vertex by more than ~1e-3 px.
+    // Clamp to the frame (or to the base vertex's own excursion): removes
+    // rounding, never moves a vertex by more than ~1e-3 px.
     const Eigen::Vector2d bk = background[k].cast<double>();
-    const double ex = Excess(bk, w1, h1);
+    const double ex = Excess(bk + base.segment<2>(2 * k), w1, h1);
     const Eigen::Vector2d q = (bk + dk)
                                   .cwiseMax(Eigen::Vector2d::Constant(-ex))
                                   .cwiseMin(Eigen::Vector2d(w1 + ex, h1 + ex));
