@@ -303,6 +303,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
           region.blend * (subject[k] - background[k]).cast<double>();
     }
   }
+  Eigen::VectorXd departure = d - base;
   // No undefined pixels: scale d towards the base if a vertex leaves the
   // input frame (more than the base's own vertex does).
   const double w1 = input_width - 1.0, h1 = input_height - 1.0;
@@ -310,7 +311,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     for (int k = 0; k < n; ++k) {
       const Eigen::Vector2d bk =
           background[k].cast<double>() + base.segment<2>(2 * k);
-      if (Excess(bk + s * (d - base).segment<2>(2 * k), w1, h1) >
+      if (Excess(bk + s * departure.segment<2>(2 * k), w1, h1) >
           Excess(bk, w1, h1) + 1e-3)
         return false;
     }
@@ -324,13 +325,14 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
       (feasible(mid) ? lo : hi) = mid;
     }
     keep = lo;
-    d = base + keep * (d - base);
+    departure *= keep;
+    d = base + departure;
   }
   r.protrusion_keep = keep;
-  // No squeezed cell: scale d further towards the background layer while a
-  // cell's ratio is below the floor (or below the background's own ratio
-  // for that cell, where that is lower already). At scale 0 every cell is
-  // the background's, so the bisection's lower end is always allowed.
+  // No squeezed cell: scale d further towards the base while a cell's ratio
+  // is below the floor (or below the base's own ratio for that cell, where
+  // that is lower already). At scale 0 every cell is the base's, so the
+  // bisection's lower end is always allowed.
   if (options_.min_cell_ratio > 0.0) {
     std::vector<Eigen::Vector2f> scaled(n);
     for (int k = 0; k < n; ++k) {
@@ -344,7 +346,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     auto unsqueezed = [&](double s) {
       for (int k = 0; k < n; ++k) {
         scaled[k] = (background[k].cast<double>() + base.segment<2>(2 * k) +
-                     s * (d - base).segment<2>(2 * k))
+                     s * departure.segment<2>(2 * k))
                         .cast<float>();
       }
       CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &ratios);
@@ -360,7 +362,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
         (unsqueezed(mid) ? lo : hi) = mid;
       }
       r.distortion_keep = lo;
-      d = base + lo * (d - base);
+      d = base + lo * departure;
     }
   }
   // Band vertex flicker, then the final mesh.
