@@ -114,6 +114,11 @@ def rel_angle(live_state, row):
     return math.acos(max(-1.0, min(1.0, (np.trace(d) - 1.0) / 2.0)))
 
 
+def BagToolParams():
+    """--params FILE for each --params given, in order."""
+    return [a for f in ARGS.params for a in ("--params", f)]
+
+
 class StabilizerTest(unittest.TestCase):
     def check_bag_loop(self, c):
         # rosbag play --loop --clock: /clock and every stamp jump back at the
@@ -150,7 +155,7 @@ class StabilizerTest(unittest.TestCase):
         second = {round(st.header.stamp.to_sec(), 3): st for st in p[1]}
         bag = ARGS.truth[:-len(".truth.csv")]
         out = os.path.join(tempfile.mkdtemp(), "traj.csv")
-        subprocess.check_call([ARGS.bag_tool, "--in", bag, "--params", ARGS.params,
+        subprocess.check_call([ARGS.bag_tool, "--in", bag, *BagToolParams(),
                                "--trajectory", out, "--quiet"])
         worst, matched, rows = 0.0, 0, 0
         with open(out) as f:
@@ -207,7 +212,7 @@ class StabilizerTest(unittest.TestCase):
         with open(stamps, "w") as f:
             for s in live.values():
                 f.write("%.6f\n" % s.header.stamp.to_sec())
-        subprocess.check_call([ARGS.bag_tool, "--in", bag, "--params", ARGS.params,
+        subprocess.check_call([ARGS.bag_tool, "--in", bag, *BagToolParams(),
                                "--trajectory", out, "--quiet", "--only-stamps", stamps])
         # Compare what is independent of where each run's world frame starts
         # (the first gyro sample each received): the virtual camera relative
@@ -368,7 +373,8 @@ if __name__ == "__main__":
     p.add_argument("--equivalence", action="store_true")
     p.add_argument("--bag-loop", action="store_true")
     p.add_argument("--layered", action="store_true")
-    p.add_argument("--params", default="")
+    p.add_argument("--params", action="append", default=[],
+                   help="YAML overlays for the bag tool, in order (repeatable)")
     p.add_argument("--bag-tool", default="steadiface_bag")
     ARGS, rest = p.parse_known_args(rospy.myargv()[1:])
     sys.argv = [sys.argv[0]] + rest
