@@ -27,6 +27,9 @@ PipelineOptions OptionsFor(const sim::Simulator& sim, Method method) {
   o.stabilizer.gyro_only = !face;
   if (method == Method::kSteadifaceLayered) o.warp.mode = WarpMode::kLayered;
   o.render_output = false;
+  // On a loaded machine (a CI job beside the evaluation) the 20 ms cap cut
+  // shake's long solves short: head 49.37 -> 51.55 px in one such run.
+  o.stabilizer.solver.max_time_s = 10.0;
   return o;
 }
 
