@@ -45,17 +45,24 @@ double BruteForceRoom(const CameraModel& m, const OutputGeometry& og, const RowR
   return lo;
 }
 
+// The 640 x 360 test camera and its output at the default 15 % crop.
+class FeasibleOffsetsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    OutputOptions oo;
+    oo.crop_ratio = 0.15;
+    ASSERT_TRUE(OutputGeometry::Create(m, oo, &og).ok());
+  }
+  const CameraModel m = testing_util::Model640x360();
+  OutputGeometry og;
+};
+
 // Global shutter, no rotation: the offsets a 15 % crop allows are the box of
 // its margin, r * W by r * H per side (to the half pixel the outer pixel
 // centres leave). With a 30 ms readout during a 1 rad/s yaw the window's
 // rows are skewed, which the x room loses; there the radii match a brute
 // force over every boundary pixel.
-TEST(FeasibleOffsetsTest, TheMarginsBoxAndWhatRollingShutterSkewTakes) {
-  const CameraModel m = testing_util::Model640x360();
-  OutputOptions oo;
-  oo.crop_ratio = 0.15;
-  OutputGeometry og;
-  ASSERT_TRUE(OutputGeometry::Create(m, oo, &og).ok());
+TEST_F(FeasibleOffsetsTest, TheMarginsBoxAndWhatRollingShutterSkewTakes) {
   const eval::FeasibleOffsets feasible(m, og, 8);
   const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
   const std::vector<double> box = feasible.Radii(RowRotations(I, 360), I, 8);
@@ -91,12 +98,8 @@ TEST(FeasibleOffsetsTest, TheMarginsBoxAndWhatRollingShutterSkewTakes) {
 // point. A pixel 100 px right of it moves by (100 (cos a - 1), 100 sin a);
 // the rolled 448 x 252 px window's extent is then a cos + b sin per axis, so
 // its room is the frame's half size less that, in closed form.
-TEST(FeasibleOffsetsTest, ARolledWindowIsTheBoxRotatedAboutThePrincipalPoint) {
-  const CameraModel m = testing_util::Model640x360();
-  OutputOptions oo;
-  oo.crop_ratio = 0.15;
-  OutputGeometry og;
-  ASSERT_TRUE(OutputGeometry::Create(m, oo, &og).ok());
+TEST_F(FeasibleOffsetsTest,
+       ARolledWindowIsTheBoxRotatedAboutThePrincipalPoint) {
   const eval::FeasibleOffsets feasible(m, og, 8);
   const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
   const RowRotations still(I, 360);
