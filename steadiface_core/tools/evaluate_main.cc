@@ -147,8 +147,7 @@ int main(int argc, char** argv) {
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
   bool feasible_set = false;     // --feasible-set: write feasible_<preset>_<method>.csv
-  double feasible_roll =
-      0.0;  // --feasible-roll: also ..._roll.csv within +-this [rad]
+  double feasible_roll = 0.0;    // --feasible-roll MAX [rad]; 0: none
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
