@@ -224,7 +224,6 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     shift = region.blend * smooth_;
     fast = Dc - smooth_;
     r.offset_px = region.blend * fast.norm() / in_per_out;
-    r.shift_px = shift.norm() / in_per_out;
   }
   double cap = 1.0;
   const double max_offset_px = options_.max_offset * B;
@@ -233,10 +232,8 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   r.capped_offset_px = r.offset_px * cap;
   // Yielding to the subject, what the cap takes from the band moves the
   // whole frame instead: the core still follows the subject layer.
-  if (options_.yield_to_subject) {
-    shift += region.blend * (1.0 - cap) * fast;
-    r.shift_px = shift.norm() / in_per_out;
-  }
+  if (options_.yield_to_subject) shift += region.blend * (1.0 - cap) * fast;
+  r.shift_px = shift.norm() / in_per_out;
   // Targets T_k. Vertices in the core and beyond the band are held at
   // their targets (their data terms dominate: they follow their layer);
   // only the band's vertices are unknowns of the least-squares problem
@@ -304,15 +301,21 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     }
   }
   Eigen::VectorXd departure = d - base;
+  // The base mesh's vertices and how far each lies outside the input frame
+  // (the pulls and the final clamp allow a vertex that much).
+  const double w1 = input_width - 1.0, h1 = input_height - 1.0;
+  std::vector<Eigen::Vector2d> base_mesh(n);
+  std::vector<double> base_excess(n);
+  for (int k = 0; k < n; ++k) {
+    base_mesh[k] = background[k].cast<double>() + base.segment<2>(2 * k);
+    base_excess[k] = Excess(base_mesh[k], w1, h1);
+  }
   // No undefined pixels: scale d towards the base if a vertex leaves the
   // input frame (more than the base's own vertex does).
-  const double w1 = input_width - 1.0, h1 = input_height - 1.0;
   auto feasible = [&](double s) {
     for (int k = 0; k < n; ++k) {
-      const Eigen::Vector2d bk =
-          background[k].cast<double>() + base.segment<2>(2 * k);
-      if (Excess(bk + s * departure.segment<2>(2 * k), w1, h1) >
-          Excess(bk, w1, h1) + 1e-3)
+      if (Excess(base_mesh[k] + s * departure.segment<2>(2 * k), w1, h1) >
+          base_excess[k] + 1e-3)
         return false;
     }
     return true;
@@ -335,19 +338,15 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   // bisection's lower end is always allowed.
   if (options_.min_cell_ratio > 0.0) {
     std::vector<Eigen::Vector2f> scaled(n);
-    for (int k = 0; k < n; ++k) {
-      scaled[k] =
-          (background[k].cast<double>() + base.segment<2>(2 * k)).cast<float>();
-    }
+    for (int k = 0; k < n; ++k) scaled[k] = base_mesh[k].cast<float>();
     std::vector<double> floor_ratio;
     CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &floor_ratio);
     for (double& q : floor_ratio) q = std::min(q, options_.min_cell_ratio);
     std::vector<double> ratios;
     auto unsqueezed = [&](double s) {
       for (int k = 0; k < n; ++k) {
-        scaled[k] = (background[k].cast<double>() + base.segment<2>(2 * k) +
-                     s * departure.segment<2>(2 * k))
-                        .cast<float>();
+        scaled[k] =
+            (base_mesh[k] + s * departure.segment<2>(2 * k)).cast<float>();
       }
       CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &ratios);
       for (size_t q = 0; q < ratios.size(); ++q) {
@@ -376,9 +375,8 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     }
     // Clamp to the frame (or to the base vertex's own excursion): removes
     // rounding, never moves a vertex by more than ~1e-3 px.
-    const Eigen::Vector2d bk = background[k].cast<double>();
-    const double ex = Excess(bk + base.segment<2>(2 * k), w1, h1);
-    const Eigen::Vector2d q = (bk + dk)
+    const double ex = base_excess[k];
+    const Eigen::Vector2d q = (background[k].cast<double>() + dk)
                                   .cwiseMax(Eigen::Vector2d::Constant(-ex))
                                   .cwiseMin(Eigen::Vector2d(w1 + ex, h1 + ex));
     (*source)[k] = q.cast<float>();
