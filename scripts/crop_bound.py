@@ -209,16 +209,15 @@ def main():
             line += " %.2f | %.2fx |" % (jl, jl / j_in)
         print(line)
 
-    for r in (float(v) for v in a.crops.split(",")):
+    crops = [float(v) for v in a.crops.split(",")]
+    for r in crops:
         M = np.array([r * W, r * H])
         row("%g %%" % (100 * r), r, lambda d, frames: np.clip(d, -M, M), 20000)
+    r = crops[0]  # the measured sets' rows: the crop of the run that wrote them
     if radii is not None:
-        r = float(a.crops.split(",")[0])
         poly = polygons(radii)
         row("%g %%, measured set" % (100 * r), r, lambda d, frames: project(poly[frames], d), 6000)
     if rolls:
-        r = float(a.crops.split(",")[0])
-
         def rolled(d, frames):
             """The closest head move to d that some roll and its shifts allow."""
             best, cost = None, None
