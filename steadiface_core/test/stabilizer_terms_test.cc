@@ -11,9 +11,9 @@
 #include <vector>
 
 #include <ceres/autodiff_cost_function.h>
-#include <ceres/manifold.h>
 #include <gtest/gtest.h>
 
+#include "steadiface_core/ceres_compat.h"
 #include "steadiface_core/so3.h"
 #include "steadiface_core/stabilizer/distortion_cost.h"
 #include "steadiface_core/stabilizer/fitting_cost.h"
@@ -28,6 +28,7 @@
 namespace steadiface {
 namespace {
 
+using ceres_compat::QuaternionTangentSpace;
 using testing_util::Model640x360;
 // ---------- Cost terms ----------
 
@@ -39,7 +40,7 @@ double Vec8Norm(const double* r) {
 // through the manifold's PlusJacobian) against central finite differences
 // of the residual along Plus(x, delta) for each tangent direction.
 void CheckGradient(ceres::CostFunction* cost_raw,
-                   std::vector<const ceres::Manifold*> manifolds,
+                   std::vector<const QuaternionTangentSpace*> manifolds,
                    std::vector<double*> params) {
   std::unique_ptr<ceres::CostFunction> cost(cost_raw);
   const int nr = cost->num_residuals();
@@ -54,7 +55,7 @@ void CheckGradient(ceres::CostFunction* cost_raw,
   }
   ASSERT_TRUE(cost->Evaluate(p.data(), r0.data(), jac.data()));
   for (size_t b = 0; b < sizes.size(); ++b) {
-    const ceres::Manifold* m = manifolds[b];
+    const QuaternionTangentSpace* m = manifolds[b];
     const int n = sizes[b];
     const int tn = m ? m->TangentSize() : n;
     std::vector<double> P(n * tn, 0.0);
@@ -111,7 +112,7 @@ TEST(CostTermsTest, FittingIsZeroAtOptimumAndGradientMatches) {
   tt[0] += 0.01;  // off the optimum by 0.01 in x: residual 3 * 0.01
   ASSERT_TRUE(c->Evaluate(p, r, nullptr));
   EXPECT_NEAR(r[0], 0.03, 1e-12);
-  ceres::EigenQuaternionManifold qm;
+  QuaternionTangentSpace qm;
   CheckGradient(FittingCost::Create(L, Rr, H, m.real_focal(), m.virtual_focal(), 3.0),
                 {&qm, nullptr}, {q, tt});
 }
@@ -136,7 +137,7 @@ TEST(CostTermsTest, DistortionLogisticIsFlatBelowThresholdAndGrowsAbove) {
   EXPECT_LT(energy(0.04), 1e-8);              // ~0 well below the threshold
   EXPECT_GT(energy(0.12), 100 * energy(0.06));  // grows fast above it
   EXPECT_GT(energy(0.2), energy(0.12));
-  ceres::EigenQuaternionManifold qm;
+  QuaternionTangentSpace qm;
   const Eigen::Quaterniond Rv = ExpSO3(Eigen::Vector3d(0.03, 0.05, -0.06)) * Rr;
   double q[4] = {Rv.x(), Rv.y(), Rv.z(), Rv.w()};
   CheckGradient(DistortionCost::Create(Rr, thr, slope, 2.0), {&qm}, {q});
@@ -158,7 +159,7 @@ TEST(CostTermsTest, FollowingIsSignInvariant) {
   ASSERT_TRUE(c->Evaluate(p, r, nullptr));
   // |q_v - q_r| = 2 sin(angle / 4) for unit quaternions.
   EXPECT_NEAR(Eigen::Map<Eigen::Vector4d>(r).norm(), 2 * std::sin(0.01 / 4), 1e-12);
-  ceres::EigenQuaternionManifold qm;
+  QuaternionTangentSpace qm;
   CheckGradient(FollowingCost::Create(Rr, 1.5), {&qm}, {q});
 }
 
@@ -180,7 +181,7 @@ TEST(CostTermsTest, RotationSmoothnessZeroForConstantVelocity) {
   params[0] = qp;
   ASSERT_TRUE(c0->Evaluate(params, r, nullptr));
   EXPECT_NEAR(Vec8Norm(r), 0.0, 1e-15);
-  ceres::EigenQuaternionManifold qm;
+  QuaternionTangentSpace qm;
   const Eigen::Quaterniond off = ExpSO3(Eigen::Vector3d(0.02, -0.01, 0.03)) * cur;
   double qo[4] = {off.x(), off.y(), off.z(), off.w()};
   CheckGradient(RotationSmoothnessCost::Create(step * p, p, p * pp.conjugate(), true, 2.0, 3.0),
@@ -229,7 +230,7 @@ TEST(CostTermsTest, ProtrusionIsZeroInsideTheMarginAndPositiveOutside) {
   EXPECT_GT(e2, e1);
   EXPECT_GT(energy(Rr, {0.12, 0.0}), 0.0);
   // Gradient where it is active.
-  ceres::EigenQuaternionManifold qm;
+  QuaternionTangentSpace qm;
   const Eigen::Quaterniond Rv = ExpSO3(Eigen::Vector3d(0.01, 0.15, 0.02)) * Rr;
   double q[4] = {Rv.x(), Rv.y(), Rv.z(), Rv.w()}, tt[2] = {0.003, 0.0017};
   CheckGradient(ProtrusionCost::Create(&geo, rows, 3.0, 0.002, 1.0), {&qm, nullptr},

@@ -13,6 +13,7 @@
 
 #include "steadiface_core/calibration/gyro_integral.h"
 #include "steadiface_core/calibration/gyro_video_check.h"
+#include "steadiface_core/ceres_compat.h"
 #include "steadiface_core/grey.h"
 #include "steadiface_core/lens_distortion.h"
 #include "steadiface_core/percentile.h"
@@ -392,7 +393,7 @@ Status Calibrator::Solve(CalibrationResult* result) {
                                 new ceres::CauchyLoss(o.loss_scale_px), q,
                                 offset, readout, bias);
     }
-    problem->SetManifold(q, new ceres::EigenQuaternionManifold);
+    ceres_compat::SetQuaternionManifold(problem.get(), q);
     problem->SetParameterLowerBound(readout, 0, 0.0);
     problem->SetParameterUpperBound(readout, 0, std::max(1e-4, period));
     if (!o.estimate_readout) problem->SetParameterBlockConstant(readout);
@@ -436,7 +437,7 @@ Status Calibrator::Solve(CalibrationResult* result) {
     if (o.estimate_readout) cov.GetCovarianceBlock(readout, readout, cr);
     if (o.estimate_bias) cov.GetCovarianceBlock(bias, bias, cb);
     const Eigen::Map<Eigen::Matrix3d> Cq(cq);
-    // EigenQuaternionManifold: Plus(x, delta) turns by 2 |delta|.
+    // The quaternion's tangent (ceres_compat.h): Plus(x, delta) turns by 2 |delta|.
     res.rotation_sigma_deg =
         2.0 *
         std::sqrt(std::max(0.0, sigma2 * Cq.eigenvalues().real().maxCoeff())) *

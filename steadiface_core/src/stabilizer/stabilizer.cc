@@ -6,10 +6,10 @@
 #include <sstream>
 #include <vector>
 
-#include <ceres/manifold.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "steadiface_core/ceres_compat.h"
 #include "steadiface_core/so3.h"
 #include "steadiface_core/stabilizer/distortion_cost.h"
 #include "steadiface_core/stabilizer/face_in_camera.h"
@@ -345,7 +345,7 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
   pp->q() = R_v0.coeffs();
   pp->t() = t0;
   ceres::Problem& problem = pp->problem;
-  problem.AddParameterBlock(pp->q_block, 4, new ceres::EigenQuaternionManifold);
+  ceres_compat::AddQuaternionBlock(&problem, pp->q_block);
   problem.AddParameterBlock(pp->t_block, 2);
   const double f_r = model_.real_focal(), f_v = model_.virtual_focal();
   if (f->has_target && w.fit > 0.0) {

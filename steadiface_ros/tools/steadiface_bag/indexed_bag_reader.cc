@@ -1,6 +1,7 @@
 #include "steadiface_bag/indexed_bag_reader.h"
 
 #include <fcntl.h>
+#include <lz4.h>
 #include <lz4frame.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -392,7 +393,9 @@ const uint8_t* IndexedBagReader::ChunkData(uint64_t pos, uint32_t* size,
   }
   LZ4F_decompressOptions_t options;
   std::memset(&options, 0, sizeof(options));
+#if LZ4_VERSION_NUMBER >= 10904  // skipChecksums is new in LZ4 1.9.4
   options.skipChecksums = verify_checksums_ ? 0 : 1;
+#endif  // older LZ4 (Ubuntu 20.04's 1.9.2, Debian 11's 1.9.3) always checks them
   size_t out = 0, in = 0;
   size_t hint = 1;
   // One frame per chunk; the loop covers a decoder that stops early.
