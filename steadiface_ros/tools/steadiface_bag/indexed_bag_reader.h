@@ -57,6 +57,7 @@ class IndexedBagReader {
 
   /// `verify_checksums`: check each LZ4 frame's XXH32 checksums, as rosbag
   /// does (an error on a mismatch; costs about as much as decompressing).
+  /// LZ4 older than 1.9.4 (Noetic's generation) always checks them.
   explicit IndexedBagReader(bool verify_checksums = false);
   ~IndexedBagReader();
   IndexedBagReader(const IndexedBagReader&) = delete;
