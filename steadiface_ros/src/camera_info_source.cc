@@ -3,40 +3,15 @@
 #include <fstream>
 
 #include <camera_calibration_parsers/parse.h>
-#include <ros/package.h>
+
+#include "steadiface_ros/resource_url.h"
 
 namespace steadiface_ros {
 
 using steadiface::Status;
 
 Status ResolveCameraInfoUrl(const std::string& url, std::string* path) {
-  const std::string file = "file://", package = "package://";
-  if (url.compare(0, file.size(), file) == 0) {
-    *path = url.substr(file.size());
-  } else if (url.compare(0, package.size(), package) == 0) {
-    const std::string rest = url.substr(package.size());
-    const size_t slash = rest.find('/');
-    if (slash == std::string::npos || slash == 0 || slash + 1 == rest.size()) {
-      return Status::Error("camera_info_url '" + url +
-                           "': expected package://PACKAGE/PATH");
-    }
-    const std::string pkg = rest.substr(0, slash);
-    const std::string dir = ros::package::getPath(pkg);
-    if (dir.empty()) {
-      return Status::Error("camera_info_url '" + url + "': package '" + pkg +
-                           "' not found");
-    }
-    *path = dir + rest.substr(slash);
-  } else if (url.find("://") != std::string::npos) {
-    return Status::Error(
-        "camera_info_url '" + url +
-        "': unsupported scheme (use file://, package:// or a path)");
-  } else {
-    *path = url;
-  }
-  if (path->empty())
-    return Status::Error("camera_info_url '" + url + "': empty path");
-  return Status::Ok();
+  return ResolveResourceUrl("camera_info_url", url, path);
 }
 
 Status LoadCameraInfoUrl(const std::string& url,

@@ -5,6 +5,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "steadiface_ros/resource_url.h"
+
 namespace steadiface_ros {
 namespace {
 
@@ -98,6 +100,17 @@ class Reader {
   }
   void Bool(const std::string& key, bool* v) { p_.Get(key, v); }
   void Str(const std::string& key, std::string* v) { p_.Get(key, v); }
+  // A file parameter: a plain path, file:// or package:// (ResolveResourceUrl).
+  void Path(const std::string& key, std::string* v) {
+    std::string url = *v;
+    p_.Get(key, &url);
+    if (url.empty()) {
+      *v = url;
+      return;
+    }
+    const Status s = ResolveResourceUrl("parameter '" + key + "'", url, v);
+    if (!s.ok()) Error(s.message());
+  }
   void Vec(const std::string& key, std::vector<double>* v) { p_.Get(key, v); }
   void Error(const std::string& msg) {
     if (error_.empty()) error_ = msg;
@@ -234,10 +247,10 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
     r.Error("parameter 'face/detector' must be dlib_hog or opencv_cascade, got '" + det + "'");
   }
   r.Int("face/detector_max_side", &f.detector.max_side_px, 64, 8192);
-  r.Str("face/cascade_path", &f.detector.cascade_path);
+  r.Path("face/cascade_path", &f.detector.cascade_path);
   r.Num("face/dlib_threshold", &f.detector.dlib_threshold, -2.0, 5.0);
   r.Int("face/min_face_px", &f.detector.min_face_px, 8, 4096);
-  r.Str("face/landmark_model", &f.landmark_model_path);
+  r.Path("face/landmark_model", &f.landmark_model_path);
   r.Int("face/redetect_every", &f.redetect_every_frames, 1, 10000);
   r.Num("face/redetect_region_scale", &f.redetect_region_scale, 1.0, 10.0);
   r.Int("face/redetect_face_px", &f.redetect_face_px, 60, 1000);

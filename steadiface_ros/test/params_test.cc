@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <dynamic_reconfigure/Config.h>
@@ -14,6 +15,8 @@ namespace steadiface_ros {
 namespace {
 
 const std::string kDefaultYaml = std::string(STEADIFACE_CONFIG_DIR) + "/default.yaml";
+const std::string kPackageCascade =
+    "package://steadiface/data/haarcascade_frontalface_default.xml";
 
 // Reads through another source and records every key whose value differs
 // from the one the caller passed in (LoadOptions passes the default).
@@ -61,9 +64,48 @@ TEST(ParamsTest, DefaultYamlStatesTheCoreDefaults) {
   const steadiface::Status s = LoadOptions(checker, &po, &wo);
   ASSERT_TRUE(s.ok()) << s.message();
   EXPECT_GT(checker.found(), 50);  // the file states (nearly) every key
+  // One deliberate difference: the cascade is named by the package's own copy
+  // (data/README.md), the same file as the core's default (next test).
+  const std::string cascade = "face/cascade_path: default.yaml " + kPackageCascade +
+                              ", core " + steadiface::FaceDetectorOptions().cascade_path;
   std::string all;
   for (const auto& d : checker.differs()) all += "\n  " + d;
-  EXPECT_TRUE(checker.differs().empty()) << "default.yaml differs from the core:" << all;
+  EXPECT_EQ(checker.differs(), std::vector<std::string>{cascade})
+      << "default.yaml differs from the core:" << all;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+TEST(ParamsTest, FileParametersResolvePackageUrls) {
+  std::unique_ptr<ParamSource> yaml;
+  ASSERT_TRUE(YamlParams({kDefaultYaml}, &yaml).ok());
+  steadiface::PipelineOptions po;
+  WrapperOptions wo;
+  ASSERT_TRUE(LoadOptions(*yaml, &po, &wo).ok());
+  // package:// needs ROS_PACKAGE_PATH; the catkin test environment has it.
+  const std::string& path = po.face.detector.cascade_path;
+  EXPECT_EQ(path.find("://"), std::string::npos) << path;
+  EXPECT_NE(path.find("/data/haarcascade_frontalface_default.xml"), std::string::npos) << path;
+  const std::string shipped = ReadFile(path);
+  EXPECT_GT(shipped.size(), 900000u) << path;
+  // Where the system copy exists (Debian's opencv-data), it is the same file.
+  const std::string system = ReadFile(steadiface::FaceDetectorOptions().cascade_path);
+  if (!system.empty()) EXPECT_TRUE(shipped == system);
+
+  const std::string overlay = ::testing::TempDir() + "steadiface_params_url.yaml";
+  {
+    std::ofstream f(overlay);
+    f << "face:\n  landmark_model: package://no_such_package_xyz/model.dat\n";
+  }
+  ASSERT_TRUE(YamlParams({kDefaultYaml, overlay}, &yaml).ok());
+  const steadiface::Status s = LoadOptions(*yaml, &po, &wo);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("face/landmark_model"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("no_such_package_xyz"), std::string::npos) << s.message();
+  std::remove(overlay.c_str());
 }
 
 TEST(ParamsTest, ReconfigureDefaultsAreTheCoreDefaults) {

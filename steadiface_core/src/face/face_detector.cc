@@ -189,8 +189,10 @@ Status FaceDetector::Create(const FaceDetectorOptions& options,
   std::unique_ptr<CascadeDetector> c(new CascadeDetector(options));
   if (!c->Load()) {
     return Status::Error("face cascade '" + options.cascade_path +
-                         "' cannot be loaded (Debian package opencv-data ships "
-                         "the default cascades)");
+                         "' cannot be loaded (the ROS package ships OpenCV's frontal "
+                         "face cascade as package://steadiface/data/"
+                         "haarcascade_frontalface_default.xml; Debian's and "
+                         "Ubuntu's opencv-data ship all of OpenCV's cascades)");
   }
   *out = std::move(c);
   return Status::Ok();
