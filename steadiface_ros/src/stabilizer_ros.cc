@@ -303,7 +303,10 @@ void StabilizerRos::DiagFace(diagnostic_updater::DiagnosticStatusWrapper& s) {
   s.add("failure", w.face_failure);
   s.add("confidence", w.face_confidence);
   s.add("landmarks_in rejected", w.counters.landmarks_bad);
-  if (pipeline_options_.landmark_source == steadiface::LandmarkSource::kNone) {
+  if (!w.landmark_model_error.empty()) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
+              "no landmark model, gyro-only: " + w.landmark_model_error);
+  } else if (pipeline_options_.landmark_source == steadiface::LandmarkSource::kNone) {
     s.summary(diagnostic_msgs::DiagnosticStatus::OK, "face processing off (gyro-only)");
   } else if (w.face_state == steadiface::TrackingState::kLost) {
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN,

@@ -34,7 +34,15 @@ StabilizerWrapper::StabilizerWrapper(const steadiface::PipelineOptions& pipeline
   if (options_.landmark_source != steadiface::LandmarkSource::kNone) {
     const steadiface::Status s =
         steadiface::LandmarkPredictor::Load(options_.face.landmark_model_path, &preloaded_model_);
-    if (!s.ok()) sink_->Error("landmark_model", s.message());
+    if (!s.ok() && options_.landmark_source == steadiface::LandmarkSource::kDlib) {
+      // The model is a one-time install (not a rosdep key): without it,
+      // stabilize from the gyro alone and keep saying why.
+      status_.landmark_model_error = s.message();
+      options_.landmark_source = steadiface::LandmarkSource::kNone;
+      sink_->Error("landmark_model", s.message() + ": stabilizing from the gyro alone");
+    } else if (!s.ok()) {
+      sink_->Error("landmark_model", s.message());
+    }
   }
 }
 

@@ -152,6 +152,38 @@ TEST(WrapperTest, CleanStreamIsStabilizedFrameByFrame) {
   for (size_t i = 1; i < stamps.size(); ++i) EXPECT_GT(stamps[i], stamps[i - 1]);
 }
 
+// A missing landmark model (a one-time install, not a rosdep key) leaves the
+// wrapper running gyro-only: every frame out, the same poses as with face
+// processing off, and the reason reported once and kept in the status.
+TEST(WrapperTest, MissingLandmarkModelFallsBackToGyroOnly) {
+  Sink off_sink, missing_sink;
+  StabilizerWrapper off(Options(), WrapperOptions(), &off_sink);
+  Feed(&off, TestStream());
+  steadiface::PipelineOptions o = Options();
+  o.landmark_source = steadiface::LandmarkSource::kDlib;
+  o.face.landmark_model_path = "/nonexistent/shape_predictor_68_face_landmarks.dat";
+  StabilizerWrapper missing(o, WrapperOptions(), &missing_sink);
+  EXPECT_EQ(missing.pipeline_options().landmark_source, steadiface::LandmarkSource::kNone);
+  Feed(&missing, TestStream());
+  EXPECT_EQ(missing_sink.errors["landmark_model"], 1);
+  EXPECT_EQ(missing_sink.errors.count("pipeline"), 0u);
+  const std::string why = missing.Status().landmark_model_error;
+  EXPECT_NE(why.find("/nonexistent/shape_predictor_68_face_landmarks.dat"), std::string::npos);
+  EXPECT_NE(why.find("apt-get install libdlib-data"), std::string::npos) << why;
+  EXPECT_TRUE(off.Status().landmark_model_error.empty());
+  ASSERT_EQ(missing_sink.states.size(), TestStream().images.size());
+  ASSERT_EQ(off_sink.states.size(), missing_sink.states.size());
+  for (size_t i = 0; i < off_sink.states.size(); ++i) {
+    const auto& a = off_sink.states[i].virtual_rotation;
+    const auto& b = missing_sink.states[i].virtual_rotation;
+    EXPECT_EQ(a.x, b.x);
+    EXPECT_EQ(a.y, b.y);
+    EXPECT_EQ(a.z, b.z);
+    EXPECT_EQ(a.w, b.w);
+  }
+  ExpectAllFinite(missing_sink);
+}
+
 // A sink that does not consume the stabilized pixels (the bag tool with
 // only a report) gets each frame's output camera_info through
 // PublishOutputInfo, and no image; everything else is what a sink that

@@ -75,8 +75,12 @@ Status LandmarkPredictor::Load(const std::string& path,
                                std::unique_ptr<LandmarkPredictor>* out,
                                const std::string& cache_dir) {
   const std::string hint =
-      " (the default model ships in Debian's libdlib-data package: "
-      "apt-get install libdlib-data, or run scripts/install_deps)";
+      " (a one-time step that rosdep cannot do: on Debian or Ubuntu, "
+      "'sudo apt-get install libdlib-data' puts the default model at "
+      "/usr/share/dlib/shape_predictor_68_face_landmarks.dat; elsewhere, "
+      "download shape_predictor_68_face_landmarks.dat.bz2 from dlib.net/files, "
+      "bunzip2 it and set face/landmark_model to its path; "
+      "or set landmark_source to 'none' for gyro-only stabilization)";
   std::ifstream probe(path, std::ios::binary);
   if (!probe.good()) {
     return Status::Error("landmark model '" + path + "' cannot be opened" +

@@ -98,6 +98,9 @@ struct WrapperStatus {
   double last_solver_ms = 0.0;
   int last_solver_iterations = 0;
   std::string last_error;
+  /// Why the landmark model could not be loaded; non-empty means the wrapper
+  /// runs gyro-only although landmark_source is dlib.
+  std::string landmark_model_error;
   /// The gyro-vs-video check as of the last frame.
   steadiface::GyroVideoCheckResult gyro_video_check;
   /// The clock offset correction applied on top of imu/time_offset [s].
