@@ -298,7 +298,8 @@ void WriteTrajectory(const std::string& path, const BagSink& sink) {
       << s.virtual_rotation.w << "," << s.principal_offset[0] << ","
       << s.principal_offset[1] << "," << s.real_rotation.x << ","
       << s.real_rotation.y << "," << s.real_rotation.z << ","
-      << s.real_rotation.w << "," << s.has_target << "," << s.target_h[0] << ","
+      << s.real_rotation.w << "," << static_cast<int>(s.has_target) << ","
+      << s.target_h[0] << ","
       << s.target_h[1] << "," << s.centre_c[0] << "," << s.centre_c[1] << ","
       << s.w_fit << "\n";
   }
