@@ -16,9 +16,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
 SCRIPT = os.path.join(REPO, "scripts", "compare_trajectories.py")
 sys.path.insert(0, os.path.join(REPO, "scripts"))
-sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, "..", "common"))
 import compare_trajectories  # noqa: E402
-from rosdep_keys_test import run_main  # noqa: E402
+from junit_unittest import run_main  # noqa: E402
 
 HEADER = "stamp,qx,qy,qz,qw,tx,ty,rqx,rqy,rqz,rqw,has_target,hx,hy,cx,cy,w_fit\n"
 

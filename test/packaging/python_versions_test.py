@@ -18,8 +18,8 @@ import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, HERE)
-from rosdep_keys_test import run_main  # noqa: E402
+sys.path.insert(0, os.path.join(HERE, "..", "common"))
+from junit_unittest import run_main  # noqa: E402
 
 OLDEST = (3, 8)
 
