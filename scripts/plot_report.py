@@ -8,6 +8,7 @@ usage: plot_report.py DIR [--presets walk,run]
 DIR holds traj_<preset>_<method>.csv files (steadiface_evaluate or
 steadiface_bag output). Writes DIR/plots/<preset>_*.png.
 """
+import argparse
 import csv
 import glob
 import os
@@ -101,13 +102,13 @@ def plot_preset(d, preset, out_dir):
 
 
 def main():
-    if len(sys.argv) < 2:
-        print(__doc__)
-        return 2
-    d = sys.argv[1]
-    presets = None
-    if "--presets" in sys.argv:
-        presets = sys.argv[sys.argv.index("--presets") + 1].split(",")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dir", help="folder with traj_<preset>_<method>.csv files")
+    ap.add_argument("--presets", help="comma-separated presets (default: every one found)")
+    args = ap.parse_args()
+    d = args.dir
+    presets = args.presets.split(",") if args.presets else None
     if presets is None:
         presets = sorted({os.path.basename(p)[5:].rsplit("_", 1)[0]
                           for p in glob.glob(os.path.join(d, "traj_*.csv"))})

@@ -2,6 +2,7 @@
 """Prints a markdown table from steadiface_bag report JSONs
 (report_<preset>_<method>.json with ground truth): input, gyro-only and
 steadiface per preset. usage: summarize_reports.py DIR"""
+import argparse
 import glob
 import json
 import os
@@ -9,7 +10,9 @@ import sys
 
 
 def main():
-    d = sys.argv[1]
+    ap = argparse.ArgumentParser(description=__doc__.split("usage:")[0].strip())
+    ap.add_argument("dir", help="folder with report_<preset>_<method>.json files")
+    d = ap.parse_args().dir
     rows = []
     for p in sorted(glob.glob(os.path.join(d, "report_*_*.json"))):
         preset, method = os.path.basename(p)[len("report_"):-len(".json")].rsplit("_", 1)

@@ -1,5 +1,5 @@
 // eval::FeasibleOffsets, what the crop margin allows per frame
-// (scripts/crop_bound.py --feasible): the margin's box in closed form, and
+// (scripts/analysis/crop_bound.py --feasible): the margin's box in closed form, and
 // a brute force over every boundary pixel under a rolling-shutter yaw.
 #include "steadiface_core/eval/feasible_offsets.h"
 

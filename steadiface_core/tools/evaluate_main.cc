@@ -117,7 +117,7 @@ int Usage() {
                "         head target's smoothing, Eq. 1)\n"
                "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
                "         per frame, the crop-window shifts the margin allows, rolling shutter\n"
-               "         included, in 72 directions [input px], for scripts/crop_bound.py)\n"
+               "         included, in 72 directions [input px], for scripts/analysis/crop_bound.py)\n"
                "       [--feasible-roll MAX] (with --feasible-set, also\n"
                "         feasible_<preset>_<method>_roll.csv: the same for a window that also\n"
                "         rolls, every 0.025 rad within +-MAX, and the true head's move when it\n"

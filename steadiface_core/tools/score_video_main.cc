@@ -2,7 +2,7 @@
 // file (no ground truth): head jitter from the detected landmark centre,
 // background jitter from KLT tracks outside the face, Liu et al. stability.
 // Prints one JSON object. Used to compare steadiface with ffmpeg's vidstab
-// and deshake on the same clip (scripts/compare_peers).
+// and deshake on the same clip (scripts/dev/compare_peers).
 //
 //   steadiface_score_video VIDEO [--fps F] [--name LABEL]
 #include <cmath>

@@ -1,4 +1,4 @@
-// The warp kernels on AArch64 (run under qemu-user by scripts/check_aarch64,
+// The warp kernels on AArch64 (run under qemu-user by scripts/dev/check_aarch64,
 // which cross-compiles this file with steadiface_core/src/mesh_sampler.cc):
 // the shuffle kernels (NEON tbl, umull + addp) against the portable
 // universal-intrinsics kernel and against an independent scalar

@@ -1,5 +1,5 @@
 """Runs a Python unittest TestCase for scripts/test: with --junit FILE it
-also writes the JUnit XML that scripts/test_summary.py counts."""
+also writes the JUnit XML that scripts/dev/test_summary.py counts."""
 import os
 import sys
 import unittest

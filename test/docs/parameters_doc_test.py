@@ -3,7 +3,7 @@
 own (not through the generator): every key of config/default.yaml has a row
 with its default, every dynamic_reconfigure parameter of
 config/Steadiface.cfg appears as a run-time name on the row of a key whose
-default is the .cfg's, and the file is what scripts/gen_parameters_doc.py
+default is the .cfg's, and the file is what scripts/dev/gen_parameters_doc.py
 writes today.
 
 usage: parameters_doc_test.py [--junit FILE]
@@ -105,7 +105,7 @@ class ParametersDocTest(unittest.TestCase):
         self.assertIn("head_w_stay (head/w_stay): the doc says 20000.0, Steadiface.cfg 5000.0", bad)
 
     def test_the_doc_is_what_the_generator_writes(self):
-        r = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "gen_parameters_doc.py"),
+        r = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "dev", "gen_parameters_doc.py"),
                             "--check"], capture_output=True, text=True)
         self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
 

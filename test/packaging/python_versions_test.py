@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Every Python file of the package parses with the grammar of Python 3.8,
 the oldest Python a ROS Noetic user has (Ubuntu 20.04; Debian 11 has 3.9, and
-scripts/check_noetic_stack runs the nodelet rostest's script there).
+scripts/dev/check_noetic_stack runs the nodelet rostest's script there).
 
 This checks syntax only (match statements, `X | Y` in annotations evaluated
 at run time are not caught by it when they are mere expressions). The

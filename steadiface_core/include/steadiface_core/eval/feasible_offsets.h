@@ -16,7 +16,7 @@ namespace eval {
 /// camera keeps the real rotation (R_v = R_r at the middle row), each
 /// boundary sample with its own row's rotation (rolling shutter, as
 /// ProtrusionGeometry checks it). A pure image shift of the crop window, so
-/// it is what a shift-only policy can use (scripts/crop_bound.py --feasible);
+/// it is what a shift-only policy can use (scripts/analysis/crop_bound.py --feasible);
 /// a virtual camera that also rotates can reach other poses.
 ///
 /// The set is given in polar form: for `directions` evenly spaced angles
@@ -38,7 +38,7 @@ class FeasibleOffsets {
   /// about the optical axis: R_v = Rz(roll) R_r (R_v world -> virtual).
   /// With it Radii() gives the set of a window that also rolls: an upper
   /// bound on what the virtual camera's third freedom adds to a shift
-  /// (scripts/crop_bound.py --feasible-roll).
+  /// (scripts/analysis/crop_bound.py --feasible-roll).
   static Eigen::Quaterniond Rolled(const Eigen::Quaterniond& middle,
                                    double roll);
 

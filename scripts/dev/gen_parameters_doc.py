@@ -21,7 +21,7 @@ import sys
 
 import yaml
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_YAML = os.path.join(REPO, "config", "default.yaml")
 CFG = os.path.join(REPO, "config", "Steadiface.cfg")
 PARAMS_CC = os.path.join(REPO, "steadiface_ros", "src", "params.cc")
@@ -200,7 +200,7 @@ def render():
              "Every private parameter of the stabilizer (`steadiface_node`, the nodelet",
              "`steadiface/StabilizerNodelet` and `steadiface_bag --params`), as",
              "`config/default.yaml` states it. **Generated** by",
-             "`scripts/gen_parameters_doc.py` from `config/default.yaml`,",
+             "`scripts/dev/gen_parameters_doc.py` from `config/default.yaml`,",
              "`config/Steadiface.cfg` and `steadiface_ros/src/params.cc`; do not edit by",
              "hand (CI fails when this file is stale).", "",
              "- **default**: the value in `config/default.yaml`, which the launch files",
@@ -237,7 +237,7 @@ def main():
     if "--check" in sys.argv:
         current = open(OUT).read() if os.path.exists(OUT) else ""
         if current != text:
-            print("docs/parameters.md is stale: run scripts/gen_parameters_doc.py")
+            print("docs/parameters.md is stale: run scripts/dev/gen_parameters_doc.py")
             return 1
         print("docs/parameters.md is current")
         return 0

@@ -24,7 +24,7 @@ that minimize sum |p_j - m_j|^2 + lambda |p_j - p_j-1|^2 (m the running
 mean, --smooth lambda; p_i-1 already shown), each window shift allowed,
 and shows p_i. With lambda 0 it is the recentre policy.
 
-    scripts/crop_bound.py out/eval/traj_run_none.csv [--point head|bg]
+    scripts/analysis/crop_bound.py out/eval/traj_run_none.csv [--point head|bg]
         [--frames A:B] (score frames A..B-1 only, e.g. the scorecard's
         longest run of finite samples) [--alpha 0.02]
         [--feasible out/eval/feasible_run_gyro-only.csv]
