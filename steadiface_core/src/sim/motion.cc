@@ -99,6 +99,14 @@ Eigen::Vector3d HeadMotion::Position(double t) const {
                     o.bob_amplitude_m * std::sin(w * t),
                     o.distance_m +
                         o.lean_amplitude_m * std::sin(2 * M_PI * o.lean_hz * t));
+  if (o.drift_amplitude_m != 0.0) {
+    const double d = 2 * M_PI * o.drift_hz * t;
+    p.x() += o.drift_amplitude_m * std::sin(d);
+    p.y() += 0.5 * o.drift_amplitude_m * std::sin(0.7 * d + 0.5);
+  }
+  if (o.walk_speed_m_s != 0.0 || o.walk_start_x_m != 0.0) {
+    p.x() += o.walk_start_x_m + o.walk_speed_m_s * t;
+  }
   return p + jitter_.Value(t);
 }
 

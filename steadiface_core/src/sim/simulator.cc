@@ -30,7 +30,8 @@ bool Active(double t, double start, double end) {
 
 const std::vector<std::string>& PresetNames() {
   static const std::vector<std::string> names = {
-      "still", "walk", "pan", "run", "occlusion", "two_faces", "turn_away", "vlog", "shake"};
+      "still", "walk", "pan", "run", "occlusion", "two_faces", "turn_away", "vlog", "shake",
+      "drift", "walk_across"};
   return names;
 }
 
@@ -90,6 +91,31 @@ Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
     walk();
     o->head.yaw_amplitude_rad = 1.2;
     o->head.yaw_hz = 0.5 / std::max(1.0, o->duration_s);
+  } else if (name == "drift") {
+    // Handheld, standing: a small tremor (0.15 deg RMS per axis) while the
+    // head drifts several cm against the scene and turns (yaw 12 deg RMS).
+    o->camera.shake_rms_rad = 0.15 * M_PI / 180.0;
+    o->camera.translation_rms_m = 0.001;
+    o->camera.pan_rate = 0.0;
+    o->body_bob_m = o->body_sway_m = 0.0;
+    o->render_torso = true;
+    o->head.distance_m = 0.6;
+    o->head.drift_amplitude_m = 0.05;
+    o->head.drift_hz = 0.2;
+    o->head.yaw_amplitude_rad = std::sqrt(2.0) * 12.0 * M_PI / 180.0;
+    o->head.yaw_hz = 0.3;
+  } else if (name == "walk_across") {
+    // Handheld, standing: the subject walks across the view, 0.9 m away,
+    // from 0.35 m left of the centre to 0.35 m right of it over the sequence.
+    o->camera.shake_rms_rad = 0.15 * M_PI / 180.0;
+    o->camera.translation_rms_m = 0.001;
+    o->camera.pan_rate = 0.0;
+    o->body_bob_m = o->body_sway_m = 0.0;
+    o->render_torso = true;
+    o->head.distance_m = 0.9;
+    o->head.bob_amplitude_m = 0.02;
+    o->head.walk_start_x_m = -0.35;
+    o->head.walk_speed_m_s = 0.7 / std::max(0.1, o->duration_s);
   } else {
     std::string all;
     for (const auto& n : PresetNames()) all += " " + n;

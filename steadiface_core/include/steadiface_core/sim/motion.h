@@ -85,6 +85,15 @@ struct HeadMotionOptions {
   double lean_hz = 0.15;
   /// Extra high-frequency head jitter RMS [m] (band 2-8 Hz).
   double jitter_rms_m = 0.0015;
+  /// Slow drift of the head against the scene: lateral amplitude [m] at
+  /// drift_hz [Hz], and half that vertically at 0.7 drift_hz (a person
+  /// shifting their weight, leaning aside). 0 = none.
+  double drift_amplitude_m = 0.0;
+  double drift_hz = 0.15;
+  /// Walking across the view: the head starts walk_start_x_m to the side
+  /// [m] and moves sideways at walk_speed_m_s [m/s]. 0 = standing.
+  double walk_start_x_m = 0.0;
+  double walk_speed_m_s = 0.0;
   uint64_t seed = 2;
 };
 
