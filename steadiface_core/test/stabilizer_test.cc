@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "steadiface_core/sim/landmark_sequence.h"
+#include "steadiface_core/stabilizer/face_in_camera.h"
 #include "steadiface_core/so3.h"
 #include "test_util.h"
 
@@ -192,6 +193,37 @@ TEST(StabilizerTest, BackgroundLayerIsExactlyTheGyroOnlyPoseAndLeavesTheSubjectA
   EXPECT_GT(max_layer_gap, 0.003);
   std::printf("  background layer: %zu frames equal to gyro-only; layers up to %.2f deg apart\n",
               two.frames_out.size(), max_layer_gap * 180.0 / M_PI);
+}
+
+// subject_reach: H stays within the reach of where the background layer
+// shows the face (per axis, in jaw widths), and the background layer stays
+// bit for bit the gyro-only pose; without the reach H leaves that box.
+TEST(StabilizerTest, SubjectReachHoldsTheTargetNearTheBackgroundLayersFace) {
+  const CameraModel m = Model640x360();
+  const sim::LandmarkSequence seq(m, Walk());
+  auto worst_over_reach = [&](double reach) {
+    StabilizerOptions so;
+    so.background_layer = true;
+    so.subject_reach = reach;
+    const RunResult r = RunSequence(m, seq, so);
+    StabilizerOptions go;
+    go.gyro_only = true;
+    const RunResult gyro = RunSequence(m, seq, go);
+    double worst = 0.0;  // max |H - C_bg|_inf / jaw width
+    for (size_t i = 0; i < r.frames_out.size(); ++i) {
+      const StabilizerFrame& f = r.frames_out[i];
+      EXPECT_EQ(f.background.R_v.coeffs(), gyro.frames_out[i].R_v.coeffs()) << i;
+      if (!f.has_target) continue;
+      FaceObservation seen;
+      EXPECT_TRUE(FaceInCamera(m, seq.frames()[i].observed, f.rows, f.R_r, f.background.R_v,
+                               f.background.t, &seen));
+      const double jaw = (seen.landmarks[0] - seen.landmarks[16]).norm();
+      worst = std::max(worst, (f.H - seen.centre).cwiseAbs().maxCoeff() / jaw);
+    }
+    return worst;
+  };
+  EXPECT_LE(worst_over_reach(0.05), 0.05 + 1e-9);
+  EXPECT_GT(worst_over_reach(0.0), 0.08);  // so the reach binds on this sequence
 }
 
 TEST(StabilizerTest, StillCameraGivesStillVirtualCamera) {

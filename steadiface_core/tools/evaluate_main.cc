@@ -113,6 +113,8 @@ int Usage() {
                "         trace: scale its rotation, or play it K times as fast)\n"
                "       [--search-interval S] (face.search_interval: full-frame face search\n"
                "         at most once per S while no face is locked; 0 = every frame)\n"
+               "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
+               "         widths of where the background layer shows the face)\n"
                "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
                "         head target's smoothing, Eq. 1)\n"
                "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
@@ -146,6 +148,7 @@ int main(int argc, char** argv) {
   double search_interval = NAN;  // face.search_interval [s]; NaN: the default
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
+  double subject_reach = 0.0;    // stabilizer.subject_reach [jaw widths]; 0: off
   bool feasible_set = false;     // --feasible-set: write feasible_<preset>_<method>.csv
   double feasible_roll = 0.0;    // --feasible-roll MAX [rad]; 0: none
   for (int i = 1; i < argc; ++i) {
@@ -170,6 +173,7 @@ int main(int argc, char** argv) {
     else if (a == "--search-interval") search_interval = std::atof(next().c_str());
     else if (a == "--head-w-stay") head_w_stay = std::atof(next().c_str());
     else if (a == "--head-d-ref") head_d_ref = std::atof(next().c_str());
+    else if (a == "--subject-reach") subject_reach = std::atof(next().c_str());
     else if (a == "--feasible-set") feasible_set = true;
     else if (a == "--feasible-roll")
       feasible_roll = std::atof(next().c_str());
@@ -326,6 +330,7 @@ int main(int argc, char** argv) {
         if (std::isfinite(search_interval)) po.face.search_interval_s = search_interval;
         if (std::isfinite(head_w_stay)) po.stabilizer.head.w_stay = head_w_stay;
         if (std::isfinite(head_d_ref)) po.stabilizer.head.d_ref = head_d_ref;
+        po.stabilizer.subject_reach = subject_reach;
         po.warp.layered.blend = blend;
         po.imu.imu_time_offset_s += offset_error;
         po.shutter.readout_time_s = std::max(0.0, po.shutter.readout_time_s + readout_error);

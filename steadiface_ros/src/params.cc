@@ -306,6 +306,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Bool("stabilizer/background_layer", &s.background_layer);
   r.Bool("stabilizer/smooth_head_in_virtual_view", &s.smooth_head_in_virtual_view);
   r.Num("stabilizer/intentional_window", &s.intentional_window_s, 0.0, 5.0);
+  r.Num("stabilizer/subject_reach", &s.subject_reach, 0.0, 10.0);
   // Output and warp.
   r.Num("output/crop_ratio", &po->warp.output.crop_ratio, 0.0, 0.4);
   r.Int("output/width", &po->warp.output.width, 0, 16384);

@@ -153,6 +153,11 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   FaceObservation held;
   const FaceObservation* fit_face = HeldFaceStep(layer, use_face ? face : nullptr, w, &held, &f);
 
+  // The background layer does not depend on the subject's: with a reach,
+  // it is solved first, and H is held within reach of where it shows the
+  // face.
+  const bool background_first = options_.background_layer && options_.subject_reach > 0.0;
+  if (background_first) BackgroundLayer(stamp, timeline, timing, &f);
   HeadTargetStep(layer, fit_face, use_face ? &world_face : nullptr, w, R_v0, t0, &f);
 
   PoseProblem problem;
@@ -167,7 +172,7 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   f.t = t;
 
   AdvanceStep(stamp, &layer, f);
-  if (options_.background_layer) BackgroundLayer(stamp, timeline, timing, &f);
+  if (options_.background_layer && !background_first) BackgroundLayer(stamp, timeline, timing, &f);
   ++stats_.frames;
   if (use_face) ++stats_.frames_with_face;
   f.timings.total_ms = MsSince(start);
@@ -322,6 +327,7 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
                            options_.smooth_head_in_virtual_view
                                ? Eigen::Vector2d(unbounded, unbounded)
                                : output_.margin());
+    if (f->background.valid) HoldWithinBackgroundReach(*face, f);
     f->has_target = true;
     f->flags.face_used = world_face != nullptr && w.fit > 0.0;
     if (world_face != nullptr) {
@@ -331,6 +337,19 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
     }
   }
   f->timings.smoothing_ms = MsSince(t_smooth);
+}
+
+void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, StabilizerFrame* f) const {
+  // Where the background layer shows the face, and the jaw's width there.
+  FaceObservation seen;
+  if (!FaceInCamera(model_, face, f->rows, f->R_r, f->background.R_v, f->background.t, &seen)) {
+    return;
+  }
+  const double jaw = seen.landmarks.size() == 68 ? (seen.landmarks[0] - seen.landmarks[16]).norm()
+                                                 : 2.0 * seen.scale;
+  const double reach = options_.subject_reach * jaw;
+  const Eigen::Vector2d d = f->H - seen.centre;
+  f->H = seen.centre + d.cwiseMax(-reach).cwiseMin(reach);
 }
 
 void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,

@@ -74,6 +74,7 @@ Status ValidateStabilizerOptions(const StabilizerOptions& o) {
       Range("row_rotation_samples", o.row_rotation_samples, 1, 4096),
       Range("min_face_confidence", o.min_face_confidence, 0, 1),
       Range("intentional_window", o.intentional_window_s, 0, 5),
+      Range("subject_reach", o.subject_reach, 0, 10),
   });
   return s;
 }

@@ -203,6 +203,9 @@ class Stabilizer {
   // Head target H (Eq. 1), and the held face updated from a usable one:
   // `world_face`, this frame's usable face as the reference camera sees it
   // (null when there is none).
+  // H within options_.subject_reach of where the background layer (solved
+  // before, in f->background) shows the face.
+  void HoldWithinBackgroundReach(const FaceObservation& face, StabilizerFrame* f) const;
   void HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face,
                       const FaceObservation* world_face, const StabilizerWeights& w,
                       const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,

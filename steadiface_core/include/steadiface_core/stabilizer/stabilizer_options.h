@@ -139,6 +139,13 @@ struct StabilizerOptions {
   /// [s] (ours; removes the lag of the paper's C0 term during pans). 0 =
   /// the paper's term (towards the previous virtual rotation).
   double intentional_window_s = 0.0;
+  /// With the background layer on: Eq. 1's H is held within this reach of
+  /// where the background layer shows the face (per axis), in jaw widths of
+  /// the face [-], so the offset between the layers at the head stays
+  /// within what a transition band can absorb and the background layer is
+  /// never moved by the face. The background layer is solved first. 0 =
+  /// off (H is not constrained by the background layer).
+  double subject_reach = 0.0;
 };
 
 Status ValidateStabilizerWeights(const StabilizerWeights& weights);
