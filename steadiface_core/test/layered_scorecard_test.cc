@@ -15,22 +15,14 @@
 #include "steadiface_core/eval/scorecard.h"
 #include "steadiface_core/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
+#include "sim_util.h"
 
 namespace steadiface {
 namespace {
 
-std::unique_ptr<sim::Simulator> Make(
-    const std::string& preset,
-    std::function<void(sim::SimulatorOptions*)> tweak = {}) {
-  sim::SimulatorOptions o;
-  o.data_dir = STEADIFACE_TEST_DATA_DIR;
-  EXPECT_TRUE(sim::ApplyPreset(preset, &o).ok());
-  o.duration_s = 3.0;
-  if (tweak) tweak(&o);
-  std::unique_ptr<sim::Simulator> s;
-  const Status st = sim::Simulator::Create(o, &s);
-  EXPECT_TRUE(st.ok()) << st.message();
-  return s;
+std::unique_ptr<sim::Simulator> Make(const std::string& preset,
+                                     std::function<void(sim::SimulatorOptions*)> tweak = {}) {
+  return testing_util::MakeSimulator(preset, tweak);
 }
 
 eval::Score Score(const sim::Simulator& s, eval::Method m) {

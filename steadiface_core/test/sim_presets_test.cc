@@ -12,20 +12,14 @@
 #include "steadiface_core/sim/motion.h"
 #include "steadiface_core/sim/simulator.h"
 #include "steadiface_core/so3.h"
+#include "sim_util.h"
 
 namespace steadiface {
 namespace {
 
 std::unique_ptr<sim::Simulator> Make(const std::string& preset,
                                      std::function<void(sim::SimulatorOptions*)> tweak = {}) {
-  sim::SimulatorOptions o;
-  o.data_dir = STEADIFACE_TEST_DATA_DIR;
-  EXPECT_TRUE(sim::ApplyPreset(preset, &o).ok());
-  if (tweak) tweak(&o);
-  std::unique_ptr<sim::Simulator> s;
-  const Status st = sim::Simulator::Create(o, &s);
-  EXPECT_TRUE(st.ok()) << st.message();
-  return s;
+  return testing_util::MakeSimulator(preset, tweak);
 }
 
 sim::HeadMotionOptions StillHead() {

@@ -8,6 +8,7 @@
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/scorecard.h"
 #include "steadiface_core/so3.h"
+#include "sim_util.h"
 #include "test_util.h"
 
 namespace steadiface {
@@ -15,14 +16,7 @@ namespace {
 
 std::unique_ptr<sim::Simulator> Make(const std::string& preset,
                                      std::function<void(sim::SimulatorOptions*)> tweak = {}) {
-  sim::SimulatorOptions o;
-  o.data_dir = STEADIFACE_TEST_DATA_DIR;
-  EXPECT_TRUE(sim::ApplyPreset(preset, &o).ok());
-  if (tweak) tweak(&o);
-  std::unique_ptr<sim::Simulator> s;
-  const Status st = sim::Simulator::Create(o, &s);
-  EXPECT_TRUE(st.ok()) << st.message();
-  return s;
+  return testing_util::MakeSimulator(preset, tweak);
 }
 
 TEST(SimulatorTest, SameSeedGivesByteIdenticalFramesImuAndTruth) {

@@ -44,6 +44,15 @@ Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
     o->body_bob_m = 0.02;
     o->body_sway_m = 0.01;
   };
+  // Handheld by someone standing: a small tremor (0.15 deg RMS per axis),
+  // the subject with neck and shoulders.
+  auto standing_tremor = [o]() {
+    o->camera.shake_rms_rad = 0.15 * M_PI / 180.0;
+    o->camera.translation_rms_m = 0.001;
+    o->camera.pan_rate = 0.0;
+    o->body_bob_m = o->body_sway_m = 0.0;
+    o->render_torso = true;
+  };
   if (name == "still") {
     o->camera.shake_rms_rad = 0.0;
     o->camera.translation_rms_m = 0.0;
@@ -92,26 +101,18 @@ Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
     o->head.yaw_amplitude_rad = 1.2;
     o->head.yaw_hz = 0.5 / std::max(1.0, o->duration_s);
   } else if (name == "drift") {
-    // Handheld, standing: a small tremor (0.15 deg RMS per axis) while the
-    // head drifts several cm against the scene and turns (yaw 12 deg RMS).
-    o->camera.shake_rms_rad = 0.15 * M_PI / 180.0;
-    o->camera.translation_rms_m = 0.001;
-    o->camera.pan_rate = 0.0;
-    o->body_bob_m = o->body_sway_m = 0.0;
-    o->render_torso = true;
+    // The head drifts several cm against the scene and turns (yaw 12 deg
+    // RMS).
+    standing_tremor();
     o->head.distance_m = 0.6;
     o->head.drift_amplitude_m = 0.05;
     o->head.drift_hz = 0.2;
     o->head.yaw_amplitude_rad = std::sqrt(2.0) * 12.0 * M_PI / 180.0;
     o->head.yaw_hz = 0.3;
   } else if (name == "walk_across") {
-    // Handheld, standing: the subject walks across the view, 0.9 m away,
-    // from 0.35 m left of the centre to 0.35 m right of it over the sequence.
-    o->camera.shake_rms_rad = 0.15 * M_PI / 180.0;
-    o->camera.translation_rms_m = 0.001;
-    o->camera.pan_rate = 0.0;
-    o->body_bob_m = o->body_sway_m = 0.0;
-    o->render_torso = true;
+    // The subject walks across the view, 0.9 m away, from 0.35 m left of
+    // the centre to 0.35 m right of it over the sequence.
+    standing_tremor();
     o->head.distance_m = 0.9;
     o->head.bob_amplitude_m = 0.02;
     o->head.walk_start_x_m = -0.35;
