@@ -247,7 +247,13 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
     r.Error("parameter 'face/detector' must be dlib_hog or opencv_cascade, got '" + det + "'");
   }
   r.Int("face/detector_max_side", &f.detector.max_side_px, 64, 8192);
-  r.Path("face/cascade_path", &f.detector.cascade_path);
+  // Resolved only where it is used: a package:// cascade must not stop a
+  // dlib_hog run started outside a sourced workspace.
+  if (f.detector.type == FaceDetectorType::kOpenCvCascade) {
+    r.Path("face/cascade_path", &f.detector.cascade_path);
+  } else {
+    r.Str("face/cascade_path", &f.detector.cascade_path);
+  }
   r.Num("face/dlib_threshold", &f.detector.dlib_threshold, -2.0, 5.0);
   r.Int("face/min_face_px", &f.detector.min_face_px, 8, 4096);
   r.Path("face/landmark_model", &f.landmark_model_path);

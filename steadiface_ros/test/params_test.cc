@@ -80,11 +80,17 @@ std::string ReadFile(const std::string& path) {
 }
 
 TEST(ParamsTest, FileParametersResolvePackageUrls) {
+  const std::string cascade = ::testing::TempDir() + "steadiface_params_cascade.yaml";
+  {
+    std::ofstream f(cascade);
+    f << "face:\n  detector: opencv_cascade\n";
+  }
   std::unique_ptr<ParamSource> yaml;
-  ASSERT_TRUE(YamlParams({kDefaultYaml}, &yaml).ok());
+  ASSERT_TRUE(YamlParams({kDefaultYaml, cascade}, &yaml).ok());
   steadiface::PipelineOptions po;
   WrapperOptions wo;
   ASSERT_TRUE(LoadOptions(*yaml, &po, &wo).ok());
+  std::remove(cascade.c_str());
   // package:// needs ROS_PACKAGE_PATH; the catkin test environment has it.
   const std::string& path = po.face.detector.cascade_path;
   EXPECT_EQ(path.find("://"), std::string::npos) << path;
@@ -105,6 +111,19 @@ TEST(ParamsTest, FileParametersResolvePackageUrls) {
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("face/landmark_model"), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("no_such_package_xyz"), std::string::npos) << s.message();
+  std::remove(overlay.c_str());
+
+  // The dlib detector does not use the cascade: an unresolvable cascade URL
+  // is kept as it is, not an error (a run outside a sourced workspace).
+  {
+    std::ofstream f(overlay);
+    f << "face:\n  cascade_path: package://no_such_package_xyz/c.xml\n";
+  }
+  ASSERT_TRUE(YamlParams({kDefaultYaml, overlay}, &yaml).ok());
+  steadiface::PipelineOptions dlib;
+  const steadiface::Status ok = LoadOptions(*yaml, &dlib, &wo);
+  EXPECT_TRUE(ok.ok()) << ok.message();
+  EXPECT_EQ(dlib.face.detector.cascade_path, "package://no_such_package_xyz/c.xml");
   std::remove(overlay.c_str());
 }
 
