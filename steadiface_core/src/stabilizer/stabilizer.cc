@@ -340,7 +340,12 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
 }
 
 void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, StabilizerFrame* f) const {
-  // Where the background layer shows the face, and the jaw's width there.
+  // Where the background layer shows the face, and the jaw's width there:
+  // the distance between the jaw's end points (landmarks 0 and 16). The
+  // layered region measures its jaw width as the jaw's horizontal extent
+  // (SubjectRegionTracker); the two agree on a frontal, upright face and
+  // differ under roll, so a reach equal to band width x cap is only about
+  // what the band absorbs.
   FaceObservation seen;
   if (!FaceInCamera(model_, face, f->rows, f->R_r, f->background.R_v, f->background.t, &seen)) {
     return;
