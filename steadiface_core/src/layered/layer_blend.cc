@@ -75,7 +75,8 @@ LayerBlend::LayerBlend(const std::vector<double>& u,
       rows_(static_cast<int>(v.size())),
       u_(u),
       v_(v),
-      options_(options) {
+      options_(options),
+      offset_lowpass_(options.offset_lowpass_hz > 0.0 ? options.offset_lowpass_hz : 1.0) {
   const int n = cols_ * rows_;
   std::vector<Eigen::Triplet<double>> s;
   int row = 0;
@@ -138,8 +139,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     d_previous_.setZero();
     e_previous_.setZero();
     has_previous_ = true;
-    has_slow_ = false;
-    has_smooth_ = false;
+    offset_lowpass_.reset();
     r.solve_ms = 0.0;
     // The background layer's own cells (one global warp).
     MeasureCells(*source, &r);
@@ -197,29 +197,10 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
         (1 - a) * b * D(i, j + 1) + a * b * D(i + 1, j + 1);
     // The slow part of the offset moves the whole frame (a type-2 tracking
     // loop: no lag on ramps such as a pan); the band absorbs the rest.
-    const double wn = 2.0 * M_PI * options_.offset_lowpass_hz;
-    if (wn <= 0.0) {
-      slow_.setZero();
-      slow_rate_.setZero();
-    } else if (!has_slow_ || !(dt > 0.0)) {
-      slow_ = Dc;
-      slow_rate_.setZero();
-      has_slow_ = true;
+    if (options_.offset_lowpass_hz <= 0.0) {
+      smooth_.setZero();
     } else {
-      const double h =
-          std::min(dt, 0.5 / wn);  // keep the loop stable on long gaps
-      const Eigen::Vector2d e = Dc - slow_;
-      slow_rate_ += wn * wn * e * h;
-      slow_ += (slow_rate_ + 2.0 * wn * e) * h;
-    }
-    // A first-order low-pass at post_ratio x the loop's frequency on top:
-    // the loop alone passes ~2 wn / w of faster motion (its zero).
-    constexpr double post_ratio = 5.0;
-    if (wn <= 0.0 || !(dt > 0.0) || !has_smooth_) {
-      smooth_ = slow_;
-      has_smooth_ = wn > 0.0;
-    } else {
-      smooth_ += (1.0 - std::exp(-dt * post_ratio * wn)) * (slow_ - smooth_);
+      smooth_ = offset_lowpass_.Update(Dc, dt);
     }
     shift = region.blend * smooth_;
     fast = Dc - smooth_;

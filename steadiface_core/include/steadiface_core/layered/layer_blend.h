@@ -8,6 +8,7 @@
 
 #include "steadiface_core/layered/subject_region.h"
 #include "steadiface_core/status.h"
+#include "steadiface_core/tracking_lowpass.h"
 
 namespace steadiface {
 
@@ -152,8 +153,7 @@ class LayerBlend {
   const std::vector<double>& cell_ratios() const { return ratios_scratch_; }
   void reset() {
     has_previous_ = false;
-    has_slow_ = false;
-    has_smooth_ = false;
+    offset_lowpass_.reset();
   }
 
  private:
@@ -172,10 +172,9 @@ class LayerBlend {
   std::vector<Eigen::Triplet<double>> triplets_;
   bool has_previous_ = false;
   Eigen::VectorXd d_previous_, e_previous_;
-  bool has_slow_ = false, has_smooth_ = false;
+  // The offset's slow part at the head centre (offset_lowpass_hz > 0).
+  TrackingLowpass offset_lowpass_;
   Eigen::Vector2d smooth_ = Eigen::Vector2d::Zero();
-  Eigen::Vector2d slow_ = Eigen::Vector2d::Zero(),
-                  slow_rate_ = Eigen::Vector2d::Zero();
   std::vector<double> alpha_;
   std::vector<double> ratios_scratch_;
 };
