@@ -41,6 +41,19 @@ Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
       timeline_(options.imu),
       region_(new SubjectRegionTracker(options.warp.layered.region)) {}
 
+StabilizerOptions ForWarp(const StabilizerOptions& options, const WarpOptions& warp) {
+  StabilizerOptions o = options;
+  if (warp.mode != WarpMode::kLayered) return o;
+  // The layered warp needs the background layer's pose every frame, and
+  // holds H within what the band absorbs of where that layer shows the face
+  // (unless a reach is given), so the face never moves the background.
+  o.background_layer = true;
+  if (!(o.subject_reach > 0.0)) {
+    o.subject_reach = warp.layered.blend.band_width * warp.layered.blend.max_offset;
+  }
+  return o;
+}
+
 Status Pipeline::Create(const CameraIntrinsics& intrinsics,
                         const PipelineOptions& options,
                         std::unique_ptr<Pipeline>* out) {
@@ -50,8 +63,7 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
   s = CameraModel::Create(intrinsics, options.camera, &model);
   if (!s.ok()) return s;
   PipelineOptions o = options;
-  // The layered warp needs the background layer's pose every frame.
-  if (o.warp.mode == WarpMode::kLayered) o.stabilizer.background_layer = true;
+  o.stabilizer = ForWarp(options.stabilizer, o.warp);
   std::unique_ptr<Pipeline> p(new Pipeline(model, o));
   if (options.landmark_source != LandmarkSource::kNone) {
     // External landmarks still go through the tracker's checks and
@@ -236,8 +248,7 @@ Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
 }
 
 Status Pipeline::UpdateStabilizerOptions(const StabilizerOptions& options) {
-  StabilizerOptions o = options;
-  if (options_.warp.mode == WarpMode::kLayered) o.background_layer = true;
+  const StabilizerOptions o = ForWarp(options, options_.warp);
   Status s = stabilizer_->UpdateOptions(o);
   if (s.ok()) options_.stabilizer = o;
   return s;
@@ -250,9 +261,9 @@ Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered
   std::unique_ptr<Warper> warper;
   Status s = Warper::Create(model_, w, &warper);
   if (!s.ok()) return s;
-  if (mode == WarpMode::kLayered && !options_.stabilizer.background_layer) {
-    StabilizerOptions so = options_.stabilizer;
-    so.background_layer = true;
+  const StabilizerOptions so = ForWarp(options_.stabilizer, w);
+  if (so.background_layer != options_.stabilizer.background_layer ||
+      so.subject_reach != options_.stabilizer.subject_reach) {
     s = stabilizer_->UpdateOptions(so);
     if (!s.ok()) return s;
     options_.stabilizer = so;

@@ -85,6 +85,7 @@ bool SameLayering(WarpMode mode, const LayeredWarpOptions& a, const WarpOptions&
          ra.neck_width_scale == rb.neck_width_scale &&
          ra.smoothing_s == rb.smoothing_s && ra.ramp_s == rb.ramp_s &&
          ba.band_width == bb.band_width && ba.band_inside == bb.band_inside &&
+         ba.outline_margin_cells == bb.outline_margin_cells &&
          ba.max_offset == bb.max_offset &&
          ba.offset_lowpass_hz == bb.offset_lowpass_hz &&
          ba.band_data_weight == bb.band_data_weight &&

@@ -52,8 +52,22 @@ SubjectRegion Region(double blend = 1.0) {
   return r;
 }
 
-LayerBlendOptions NoSlowShift() {
+// A band that straddles the outline, a whole-frame shift for the offset's
+// slow part and the face first where the layers cannot be joined: the
+// mechanisms the default (a band inside the subject that never bends the
+// background) switches off, still options.
+LayerBlendOptions Straddling() {
   LayerBlendOptions o;
+  o.band_width = 0.5;
+  o.band_inside = 0.5;
+  o.outline_margin_cells = 0.0;
+  o.offset_lowpass_hz = 0.1;
+  o.yield_to_subject = true;
+  return o;
+}
+
+LayerBlendOptions NoSlowShift() {
+  LayerBlendOptions o = Straddling();
   o.offset_lowpass_hz = 0.0;  // the band absorbs the whole offset
   return o;
 }
@@ -167,6 +181,59 @@ TEST(LayerBlendTest, CoreFollowsTheSubjectLayerAndTheBackgroundStaysPut) {
   EXPECT_LT(rep.min_cell_ratio, 0.995);  // the band does bend
   EXPECT_NEAR(rep.offset_px, T.norm(), 0.05);
   EXPECT_DOUBLE_EQ(rep.protrusion_keep, 1.0);
+}
+
+// The defaults never bend the background: every cell that reaches outside
+// the subject's outline (where the background shows) keeps all four
+// vertices exactly on the background layer, while the head's core follows
+// the subject layer, and the band inside the outline absorbs an offset of
+// band width x max_offset without squeezing a cell below 0.5.
+TEST(LayerBlendTest, TheDefaultBandNeverBendsTheBackground) {
+  const Grid g;
+  const auto background = g.Background();
+  const LayerBlendOptions o;
+  const SubjectRegion region = Region();
+  const double reach = o.band_width * o.max_offset * region.jaw_width;  // 12.25 px
+  for (const Eigen::Vector2d& T : {Eigen::Vector2d(reach, 0.0), Eigen::Vector2d(0.0, -reach),
+                                   Eigen::Vector2d(0.7 * reach, 0.7 * reach)}) {
+    LayerBlend blend(g.u, g.v, o);
+    std::vector<Eigen::Vector2f> out;
+    LayerBlendReport rep;
+    blend.Blend(Shifted(background, T), background, region, 0.0, 840, 460, &out, &rep);
+    ASSERT_TRUE(rep.layered);
+    const int cols = static_cast<int>(g.u.size());
+    int outside_cells = 0;
+    for (int j = 0; j + 1 < static_cast<int>(g.v.size()); ++j) {
+      for (int i = 0; i + 1 < cols; ++i) {
+        const int c[4] = {j * cols + i, j * cols + i + 1, (j + 1) * cols + i,
+                          (j + 1) * cols + i + 1};
+        bool reaches_out = false;
+        for (int k : c) reaches_out = reaches_out || region.SignedDistance(g.At(k)) > 0.0;
+        if (!reaches_out) continue;
+        ++outside_cells;
+        for (int k : c) {
+          EXPECT_EQ(out[k], background[k]) << "vertex " << k << " of a cell reaching the background";
+        }
+      }
+    }
+    EXPECT_GT(outside_cells, 400);
+    // The core: deeper inside than the band and the margin (a cell
+    // diagonal, 28.2 px here). On this small head (jaw 100 px on a 20 px
+    // grid) that leaves a core of ~7 px: 5 vertices, in the shoulders.
+    const double inner = -(o.band_width * region.jaw_width +
+                           o.outline_margin_cells * std::hypot(g.u[1] - g.u[0], g.v[1] - g.v[0]));
+    int core = 0;
+    for (int k = 0; k < g.n(); ++k) {
+      if (region.SignedDistance(g.At(k)) > inner) continue;
+      EXPECT_LT(((out[k] - background[k]).cast<double>() - T).norm(), 1e-3) << "core vertex " << k;
+      ++core;
+    }
+    EXPECT_GE(core, 5);
+    EXPECT_EQ(rep.folded_cells, 0);
+    EXPECT_GE(rep.min_cell_ratio, 0.5);
+    EXPECT_DOUBLE_EQ(rep.distortion_keep, 1.0);
+    EXPECT_DOUBLE_EQ(rep.shift_px, 0.0);  // nothing moves the whole frame
+  }
 }
 
 // The similarity term is what tames the bending: the optimized band is less
@@ -352,7 +419,7 @@ TEST(LayerBlendTest, ALaggingShiftNeverDragsTheHeadWhenYieldingToTheSubject) {
   }
   const int centre = 9 * 33 + 16;  // in the core
   for (const bool to_subject : {false, true}) {
-    LayerBlendOptions o;
+    LayerBlendOptions o = Straddling();
     o.yield_to_subject = to_subject;
     LayerBlend blend(g.u, g.v, o);
     std::vector<Eigen::Vector2f> out;
@@ -398,7 +465,7 @@ TEST(LayerBlendTest, AHeldOffsetMovesIntoTheWholeFrameShift) {
   const Grid g;
   const auto background = g.Background();
   const Eigen::Vector2d T(10.0, 0.0);
-  LayerBlend blend(g.u, g.v, LayerBlendOptions());
+  LayerBlend blend(g.u, g.v, Straddling());
   std::vector<Eigen::Vector2f> out;
   LayerBlendReport rep;
   // Start with no offset, then step to T and hold it 20 s.

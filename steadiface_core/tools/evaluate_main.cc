@@ -105,7 +105,7 @@ int Usage() {
                "       [--methods none,gyro-only,steadiface,steadiface-layered,none/video,\n"
                "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
                "       [--size WxH] [--seed N] [--render] [--crop R]\n"
-               "       [--band W] [--band-inside F] [--max-offset C] [--offset-lowpass HZ]\n"
+               "       [--band W] [--band-inside F] [--outline-margin CELLS] [--max-offset C] [--offset-lowpass HZ]\n"
                "       [--yield-to-background] (the layered warp's warp/layered/* options,\n"
                "         for sweeps; the last sets yield_to_subject false)\n"
                "       [--offset-error S] [--readout-error S] (misconfigure the IMU timing)\n"
@@ -115,6 +115,8 @@ int Usage() {
                "         at most once per S while no face is locked; 0 = every frame)\n"
                "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
                "         widths of where the background layer shows the face)\n"
+               "       [--reach-lowpass HZ] [--reach-hold F] (stabilizer.subject_reach_lowpass,\n"
+               "         subject_reach_hold: H follows the slow part of that position)\n"
                "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
                "         head target's smoothing, Eq. 1)\n"
                "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
@@ -149,6 +151,8 @@ int main(int argc, char** argv) {
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
   double subject_reach = 0.0;    // stabilizer.subject_reach [jaw widths]; 0: off
+  double reach_lowpass = NAN;    // stabilizer.subject_reach_lowpass_hz (NaN: default)
+  double reach_hold = NAN;       // stabilizer.subject_reach_hold (NaN: default)
   bool feasible_set = false;     // --feasible-set: write feasible_<preset>_<method>.csv
   double feasible_roll = 0.0;    // --feasible-roll MAX [rad]; 0: none
   for (int i = 1; i < argc; ++i) {
@@ -174,11 +178,14 @@ int main(int argc, char** argv) {
     else if (a == "--head-w-stay") head_w_stay = std::atof(next().c_str());
     else if (a == "--head-d-ref") head_d_ref = std::atof(next().c_str());
     else if (a == "--subject-reach") subject_reach = std::atof(next().c_str());
+    else if (a == "--reach-lowpass") reach_lowpass = std::atof(next().c_str());
+    else if (a == "--reach-hold") reach_hold = std::atof(next().c_str());
     else if (a == "--feasible-set") feasible_set = true;
     else if (a == "--feasible-roll")
       feasible_roll = std::atof(next().c_str());
     else if (a == "--band") blend.band_width = std::atof(next().c_str());
     else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
+    else if (a == "--outline-margin") blend.outline_margin_cells = std::atof(next().c_str());
     else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
     else if (a == "--yield-to-background")
       blend.yield_to_subject = false;
@@ -230,8 +237,9 @@ int main(int argc, char** argv) {
                " | head-vs-bg jitter px | bg floor px"
                " | head stability | bg stability | cropping | distortion | undefined frames |"
                " solver p50 ms | face p50 ms | visible bg jitter px | line deviation px |"
-               " min cell ratio | band jitter px | scoring |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+               " line p99 px | min cell ratio | band jitter px | blend step px (max, 2nd diff) |"
+               " head step px (max, 2nd diff) | head target step px (max, 2nd diff) | scoring |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   bool first = true;
   int failures = 0;
   auto fmt = [](const char* f, double v) {
@@ -331,6 +339,8 @@ int main(int argc, char** argv) {
         if (std::isfinite(head_w_stay)) po.stabilizer.head.w_stay = head_w_stay;
         if (std::isfinite(head_d_ref)) po.stabilizer.head.d_ref = head_d_ref;
         po.stabilizer.subject_reach = subject_reach;
+        if (std::isfinite(reach_lowpass)) po.stabilizer.subject_reach_lowpass_hz = reach_lowpass;
+        if (std::isfinite(reach_hold)) po.stabilizer.subject_reach_hold = reach_hold;
         po.warp.layered.blend = blend;
         po.imu.imu_time_offset_s += offset_error;
         po.shutter.readout_time_s = std::max(0.0, po.shutter.readout_time_s + readout_error);
@@ -407,8 +417,14 @@ int main(int argc, char** argv) {
                 << fmt("%.1f%%", 100 * sc.undefined_fraction) << " | " << fmt("%.3f", solver)
                 << " | " << fmt("%.2f", face) << " | "
                 << fmt("%.2f", sc.visible_background_jitter_px) << " | "
-                << fmt("%.2f", sc.line_deviation_px) << " | " << fmt("%.3f", sc.min_cell_ratio)
-                << " | " << fmt("%.2f", sc.band_jitter_px) << " | " << scoring << " |"
+                << fmt("%.2f", sc.line_deviation_px) << " | "
+                << fmt("%.2f", sc.line_deviation_p99_px) << " | " << fmt("%.3f", sc.min_cell_ratio)
+                << " | " << fmt("%.2f", sc.band_jitter_px) << " | "
+                << fmt("%.2f", sc.blend_max_step_px) << ", " << fmt("%.2f", sc.blend_max_accel_px)
+                << " | " << fmt("%.2f", sc.head_max_step_px) << ", "
+                << fmt("%.2f", sc.head_max_accel_px)
+                << " | " << fmt("%.2f", sc.head_target_max_step_px) << ", "
+                << fmt("%.2f", sc.head_target_max_accel_px) << " | " << scoring << " |"
                 << std::endl;
       json << (first ? "" : ",\n") << "    {\"preset\": \"" << preset
            << "\", \"duration_s\": " << so.duration_s << ", \"method\": \"" << name
@@ -432,6 +448,13 @@ int main(int argc, char** argv) {
            << ", \"p01_cell_ratio\": " << jnum(sc.p01_cell_ratio)
            << ", \"folded_cells\": " << sc.folded_cells
            << ", \"band_jitter_px\": " << jnum(sc.band_jitter_px)
+           << ", \"line_deviation_p99_px\": " << jnum(sc.line_deviation_p99_px)
+           << ", \"blend_max_step_px\": " << jnum(sc.blend_max_step_px)
+           << ", \"blend_max_accel_px\": " << jnum(sc.blend_max_accel_px)
+           << ", \"head_max_step_px\": " << jnum(sc.head_max_step_px)
+           << ", \"head_max_accel_px\": " << jnum(sc.head_max_accel_px)
+           << ", \"head_target_max_step_px\": " << jnum(sc.head_target_max_step_px)
+           << ", \"head_target_max_accel_px\": " << jnum(sc.head_target_max_accel_px)
            << ", \"peer_wall_ms_per_frame\": " << jnum(peer_ms) << ", \"stage_ms\": {";
       for (size_t k = 0; k < sc.stage_ms.size(); ++k) {
         json << (k ? ", " : "") << "\"" << sc.stage_ms[k].first << "\": ["

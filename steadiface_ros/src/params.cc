@@ -332,6 +332,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Int("warp/layered/mesh_rows", &lw.mesh_rows, 2, 512);
   r.Num("warp/layered/band_width", &lw.blend.band_width, 0.02, 10.0);
   r.Num("warp/layered/band_inside", &lw.blend.band_inside, 0.0, 1.0);
+  r.Num("warp/layered/outline_margin", &lw.blend.outline_margin_cells, 0.0, 4.0);
   r.Num("warp/layered/max_offset", &lw.blend.max_offset, 0.0, 10.0);
   r.Num("warp/layered/offset_lowpass", &lw.blend.offset_lowpass_hz, 0.0, 10.0);
   r.Num("warp/layered/band_data_weight", &lw.blend.band_data_weight, 1e-6, 1.0);
@@ -412,6 +413,7 @@ void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::WarpMode* mo
   if (steadiface::ParseWarpMode(c.warp_mode, &m).ok()) *mode = m;
   layered->blend.band_width = c.band_width;
   layered->blend.band_inside = c.band_inside;
+  layered->blend.outline_margin_cells = c.outline_margin;
   layered->blend.max_offset = c.max_offset;
   layered->blend.offset_lowpass_hz = c.offset_lowpass;
   layered->blend.yield_to_subject = c.yield_to_subject;
@@ -462,6 +464,7 @@ steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptio
   c.warp_mode = steadiface::WarpModeName(w.mode);
   c.band_width = w.layered.blend.band_width;
   c.band_inside = w.layered.blend.band_inside;
+  c.outline_margin = w.layered.blend.outline_margin_cells;
   c.max_offset = w.layered.blend.max_offset;
   c.offset_lowpass = w.layered.blend.offset_lowpass_hz;
   c.yield_to_subject = w.layered.blend.yield_to_subject;

@@ -48,6 +48,12 @@ struct PipelineOptions {
 
 Status ValidatePipelineOptions(const PipelineOptions& options);
 
+/// The stabilizer options a warp needs: in layered mode the background
+/// layer is solved every frame, and H is held within subject_reach of where
+/// it shows the face; a subject_reach of 0 becomes what the band absorbs,
+/// warp.layered.blend.band_width x max_offset jaw widths.
+StabilizerOptions ForWarp(const StabilizerOptions& options, const WarpOptions& warp);
+
 struct PipelineTimings {
   double face_ms = 0.0;
   double check_ms = 0.0;  ///< GyroVideoCheck

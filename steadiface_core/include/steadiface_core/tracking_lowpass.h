@@ -34,3 +34,43 @@ class TrackingLowpass {
 };
 
 }  // namespace steadiface
+
+namespace steadiface {
+
+/// The slow part of a 2D position, such as a head's drift or a subject
+/// walking across the view, without lag on ramps and without a slow start:
+/// a constant-velocity Kalman filter (per axis; white acceleration noise of
+/// density (2 pi hz)^4 against unit measurement noise density, so its
+/// steady state is a type-2 tracking loop at natural frequency `hz`, damping
+/// 0.71), started with an unknown velocity so a ramp is picked up within a
+/// few samples instead of after the loop's settling time (several 1 / hz);
+/// then a first-order low-pass at 5x `hz`, fed the position moved ahead by
+/// the velocity times its time constant, so a ramp passes it without lag
+/// too, while it attenuates what the loop passes of faster motion (about
+/// 2 hz / f at a frequency f).
+class SlowMotionFilter {
+ public:
+  /// `hz` > 0 [Hz].
+  explicit SlowMotionFilter(double hz = 1.0) : hz_(hz) {}
+
+  /// Feeds `x`, `dt` [s] after the last sample, and returns the slow part.
+  /// The first sample after construction or reset(), or one with dt <= 0
+  /// (or NaN), restarts the filter at `x` with an unknown velocity.
+  const Eigen::Vector2d& Update(const Eigen::Vector2d& x, double dt);
+
+  const Eigen::Vector2d& value() const { return smooth_; }
+  const Eigen::Vector2d& velocity() const { return velocity_; }
+  bool started() const { return started_; }
+  void reset() { started_ = false; }
+
+ private:
+  double hz_;
+  bool started_ = false;
+  bool has_covariance_ = false;     // P is set from the first step's dt
+  Eigen::Matrix2d P_ = Eigen::Matrix2d::Zero();  // (position, velocity)
+  Eigen::Vector2d position_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d velocity_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d smooth_ = Eigen::Vector2d::Zero();
+};
+
+}  // namespace steadiface

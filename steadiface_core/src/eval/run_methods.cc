@@ -98,6 +98,8 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
     w.R_v = out.stabilizer.R_v;
     w.t = out.stabilizer.t;
     w.rows = out.stabilizer.rows;
+    w.has_head_target = out.stabilizer.has_target;
+    w.head_target = out.stabilizer.H;
     if (o.warp.mode == WarpMode::kLayered) {
       // The joined mesh is the warp (the subject pose holds only inside the
       // region).

@@ -18,6 +18,21 @@ namespace steadiface {
 namespace eval {
 namespace {
 
+// Raises *step and *accel to the largest first and second differences of a
+// trajectory over consecutive finite samples; false when there is no pair.
+bool LargestSteps(const std::vector<Eigen::Vector2d>& p, double* step, double* accel) {
+  bool any = false;
+  for (size_t t = 1; t < p.size(); ++t) {
+    if (!p[t].allFinite() || !p[t - 1].allFinite()) continue;
+    any = true;
+    *step = std::max(*step, (p[t] - p[t - 1]).norm());
+    if (t >= 2 && p[t - 2].allFinite()) {
+      *accel = std::max(*accel, (p[t] - 2.0 * p[t - 1] + p[t - 2]).norm());
+    }
+  }
+  return any;
+}
+
 // The longest run [first, second) of consecutive indices in [0, n) where
 // `ok(i)` holds; the first such run on ties, empty if there is none.
 template <typename Pred>
@@ -220,6 +235,8 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     if (k == 13) s.background_out = o;  // centre of the middle view
   }
   if (w.kind != FrameWarp::Kind::kIdentity) identity_ = false;
+  head_target_out_.push_back(w.has_head_target ? output_.VirtualToOutputPixel(w.head_target)
+                                               : Eigen::Vector2d::Constant(NAN));
   // Visible background and straight lines: input pixels the subject does
   // not cover, landing inside the output image.
   const double ow = w.kind == FrameWarp::Kind::kIdentity ? ki.width : output_.width();
@@ -241,6 +258,7 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     auto flush = [&] {
       if (run.size() >= 5) {
         const double dev = LineDeviation(run);
+        line_devs_.push_back(dev);
         if (dev > line_dev_) {
           line_dev_ = dev;
           line_dev_frame_ = index;
@@ -430,6 +448,22 @@ Score Scorecard::Compute() const {
     ++nband;
   }
   sc.band_jitter_px = nband ? band / nband : NAN;
+  if (!line_devs_.empty()) sc.line_deviation_p99_px = Percentile(line_devs_, 0.99);
+  if (!band_offsets_.empty()) {
+    sc.blend_max_step_px = 0.0;
+    sc.blend_max_accel_px = 0.0;
+    for (const auto& traj : band_offsets_) LargestSteps(traj, &sc.blend_max_step_px, &sc.blend_max_accel_px);
+  }
+  double head_step = 0.0, head_accel = 0.0;
+  if (LargestSteps(head_out_, &head_step, &head_accel)) {
+    sc.head_max_step_px = head_step;
+    sc.head_max_accel_px = head_accel;
+  }
+  double step = 0.0, accel = 0.0;
+  if (LargestSteps(head_target_out_, &step, &accel)) {
+    sc.head_target_max_step_px = step;
+    sc.head_target_max_accel_px = accel;
+  }
   sc.cropping = pose ? std::pow(1.0 - 2.0 * output_.crop_ratio(), 2.0) : 1.0;
   sc.distortion = *std::min_element(distortion_.begin(), distortion_.end());
   sc.undefined_fraction = static_cast<double>(undefined_) / sc.frames;

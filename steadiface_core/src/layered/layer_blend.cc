@@ -51,6 +51,9 @@ Status ValidateLayerBlendOptions(const LayerBlendOptions& o) {
     err << "warp.layered.max_offset must be in [0, 10] band widths (0 = no "
            "cap), got "
         << o.max_offset;
+  } else if (!in(o.outline_margin_cells, 0.0, 4.0)) {
+    err << "warp.layered.outline_margin must be in [0, 4] cells, got "
+        << o.outline_margin_cells;
   } else if (!in(o.offset_lowpass_hz, 0.0, 10.0)) {
     err << "warp.layered.offset_lowpass_hz must be in [0, 10] Hz (0 = off), "
            "got "
@@ -78,6 +81,10 @@ LayerBlend::LayerBlend(const std::vector<double>& u,
       options_(options),
       offset_lowpass_(options.offset_lowpass_hz > 0.0 ? options.offset_lowpass_hz : 1.0) {
   const int n = cols_ * rows_;
+  double du = 0.0, dv = 0.0;
+  for (int i = 0; i + 1 < cols_; ++i) du = std::max(du, u_[i + 1] - u_[i]);
+  for (int j = 0; j + 1 < rows_; ++j) dv = std::max(dv, v_[j + 1] - v_[j]);
+  cell_diagonal_ = std::hypot(du, dv);
   std::vector<Eigen::Triplet<double>> s;
   int row = 0;
   auto id = [this](int i, int j) { return j * cols_ + i; };
@@ -164,7 +171,8 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   // The band runs from band_inside * B inside the outline to the rest of B
   // outside it.
   const double B = std::max(1.0, options_.band_width * region.jaw_width);
-  const double outer = (1.0 - options_.band_inside) * B;
+  const double outer =
+      (1.0 - options_.band_inside) * B - options_.outline_margin_cells * cell_diagonal_;
   r.band_px = B;
   r.band_outer_px = outer;
   std::vector<bool> free_vertex(n);

@@ -23,6 +23,17 @@
 namespace steadiface {
 namespace {
 
+// The reach anchor's frequency (a valid one while the anchor is off).
+double ReachAnchorHz(const StabilizerOptions& o) {
+  return o.subject_reach_lowpass_hz > 0.0 ? o.subject_reach_lowpass_hz : 1.0;
+}
+
+// v shortened to length `r` if longer.
+Eigen::Vector2d ClampNorm(const Eigen::Vector2d& v, double r) {
+  const double n = v.norm();
+  return n > r && n > 0.0 ? Eigen::Vector2d(v * (r / n)) : v;
+}
+
 using Clock = std::chrono::steady_clock;
 
 double MsSince(Clock::time_point start) {
@@ -84,7 +95,8 @@ Stabilizer::Stabilizer(const CameraModel& model, const OutputGeometry& output,
       options_(options),
       smoother_(options.head),
       dynamic_(options.dynamic),
-      background_dynamic_(options.dynamic) {}
+      background_dynamic_(options.dynamic),
+      reach_anchor_(ReachAnchorHz(options)) {}
 
 Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
   Status s = ValidateStabilizerOptions(options);
@@ -93,6 +105,10 @@ Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
       options_.terms.protrusion_samples_per_edge) {
     return Status::Error(
         "terms.protrusion_samples_per_edge cannot change at run time");
+  }
+  if (ReachAnchorHz(options) != ReachAnchorHz(options_)) {
+    reach_anchor_ = SlowMotionFilter(ReachAnchorHz(options));
+    reach_anchor_fed_ = false;
   }
   options_ = options;
   smoother_ = HeadSmoother(options.head);
@@ -108,6 +124,7 @@ void Stabilizer::reset() {
   has_held_face_ = false;
   dynamic_.reset();
   background_dynamic_.reset();
+  reach_anchor_fed_ = false;
   ++stats_.resets;
 }
 
@@ -158,7 +175,7 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   // face.
   const bool background_first = options_.background_layer && options_.subject_reach > 0.0;
   if (background_first) BackgroundLayer(stamp, timeline, timing, &f);
-  HeadTargetStep(layer, fit_face, use_face ? &world_face : nullptr, w, R_v0, t0, &f);
+  HeadTargetStep(layer, fit_face, use_face ? &world_face : nullptr, w, R_v0, t0, dt, &f);
 
   PoseProblem problem;
   Eigen::Quaterniond R_v = R_v0;
@@ -287,7 +304,7 @@ const FaceObservation* Stabilizer::HeldFaceStep(const LayerState& layer,
 void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face,
                                 const FaceObservation* world_face, const StabilizerWeights& w,
                                 const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
-                                StabilizerFrame* f) {
+                                double dt, StabilizerFrame* f) {
   // Target head centre (Eq. 1).
   const auto t_smooth = Clock::now();
   if (fit_face != nullptr) {
@@ -327,7 +344,7 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
                            options_.smooth_head_in_virtual_view
                                ? Eigen::Vector2d(unbounded, unbounded)
                                : output_.margin());
-    if (f->background.valid) HoldWithinBackgroundReach(*face, f);
+    if (f->background.valid) HoldWithinBackgroundReach(*face, dt, f);
     f->has_target = true;
     f->flags.face_used = world_face != nullptr && w.fit > 0.0;
     if (world_face != nullptr) {
@@ -339,7 +356,8 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
   f->timings.smoothing_ms = MsSince(t_smooth);
 }
 
-void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, StabilizerFrame* f) const {
+void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, double dt,
+                                           StabilizerFrame* f) {
   // Where the background layer shows the face, and the jaw's width there:
   // the distance between the jaw's end points (landmarks 0 and 16). The
   // layered region measures its jaw width as the jaw's horizontal extent
@@ -347,14 +365,30 @@ void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, Stabiliz
   // differ under roll, so a reach equal to band width x cap is only about
   // what the band absorbs.
   FaceObservation seen;
+  const bool fed = reach_anchor_fed_ && reach_anchor_frame_ + 1 == stats_.frames;
+  reach_anchor_fed_ = false;
   if (!FaceInCamera(model_, face, f->rows, f->R_r, f->background.R_v, f->background.t, &seen)) {
     return;
   }
   const double jaw = seen.landmarks.size() == 68 ? (seen.landmarks[0] - seen.landmarks[16]).norm()
                                                  : 2.0 * seen.scale;
   const double reach = options_.subject_reach * jaw;
-  const Eigen::Vector2d d = f->H - seen.centre;
-  f->H = seen.centre + d.cwiseMax(-reach).cwiseMin(reach);
+  Eigen::Vector2d H = f->H;
+  if (options_.subject_reach_lowpass_hz > 0.0) {
+    // Follow the slow part S of where the background layer shows the face
+    // (its drift): Eq. 1's H may hold still only within the hold of S, so
+    // the rest of the reach is left for the face's fast motion, which H
+    // does not follow. A face that appears or comes back restarts S at its
+    // position (no jump: H starts there too).
+    if (!fed) reach_anchor_.reset();
+    const Eigen::Vector2d S = reach_anchor_.Update(seen.centre, fed ? dt : 0.0);
+    reach_anchor_fed_ = true;
+    reach_anchor_frame_ = stats_.frames;
+    H = S + ClampNorm(H - S, options_.subject_reach_hold * reach);
+  }
+  // A disc, not Eq. 1's box: the band absorbs an offset in any direction
+  // alike.
+  f->H = seen.centre + ClampNorm(H - seen.centre, reach);
 }
 
 void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,

@@ -75,6 +75,8 @@ Status ValidateStabilizerOptions(const StabilizerOptions& o) {
       Range("min_face_confidence", o.min_face_confidence, 0, 1),
       Range("intentional_window", o.intentional_window_s, 0, 5),
       Range("subject_reach", o.subject_reach, 0, 10),
+      Range("subject_reach_lowpass", o.subject_reach_lowpass_hz, 0, 10),
+      Range("subject_reach_hold", o.subject_reach_hold, 0, 1),
   });
   return s;
 }

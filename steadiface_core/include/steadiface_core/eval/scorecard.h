@@ -35,6 +35,10 @@ struct FrameWarp {
   std::vector<double> mesh_u, mesh_v;
   std::vector<Eigen::Vector2f> mesh_source, mesh_background;
   std::vector<double> mesh_blend;
+  /// The stabilizer's head target H (Eq. 1) in the virtual view, when it
+  /// had one (for the target's per-frame steps); optional.
+  bool has_head_target = false;
+  Eigen::Vector2d head_target = Eigen::Vector2d::Zero();
   /// Per-stage time of this frame [ms] (name, value); optional.
   std::vector<std::pair<std::string, double>> stage_ms;
 };
@@ -83,6 +87,19 @@ struct Score {
   /// frame where it happened. A global warp keeps them straight (~0).
   double line_deviation_px = 0.0;
   int line_deviation_frame = -1;
+  /// The 99th percentile of the same deviation over every (line, frame)
+  /// visible run [output px].
+  double line_deviation_p99_px = 0.0;
+  /// Hand-overs without jumps. kMesh with a background mesh: the largest
+  /// per-frame step of any vertex's offset from the background layer, and
+  /// the largest second difference (a jump shows as both; steady motion
+  /// only in the first) [output px]. NaN otherwise.
+  double blend_max_step_px = NAN, blend_max_accel_px = NAN;
+  /// The same for the true head centre in the output (what a viewer sees
+  /// of the face's motion) and for the head target H, in output px, over
+  /// frames with a value on this and the previous frame(s). NaN without.
+  double head_max_step_px = NAN, head_max_accel_px = NAN;
+  double head_target_max_step_px = NAN, head_target_max_accel_px = NAN;
   /// kMesh: cells' singular-value ratios over all frames: the worst, the
   /// 1st percentile (99 % of cells are at least this), and fold-overs.
   double min_cell_ratio = 1.0, p01_cell_ratio = 1.0;
@@ -151,6 +168,9 @@ class Scorecard {
   std::vector<std::vector<Eigen::Vector3d>> lines_;
   double line_dev_ = 0.0;
   int line_dev_frame_ = -1;
+  std::vector<double> line_devs_;
+  // The head target in output px per frame (NaN without one).
+  std::vector<Eigen::Vector2d> head_target_out_;
   std::vector<double> cell_ratios_;
   double min_ratio_ = 1.0;
   int min_ratio_frame_ = -1;

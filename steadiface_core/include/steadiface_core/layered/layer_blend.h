@@ -17,11 +17,18 @@ struct LayerBlendOptions {
   /// Width of the transition band where the mesh bends from the subject
   /// layer to the background layer, in jaw widths of the face (so it scales
   /// with the face's size in the output) [-].
-  double band_width = 0.5;
+  double band_width = 0.35;
   /// Fraction of the band that lies inside the region's outline, on the
   /// subject's periphery (hair, neck, shoulders), rather than on the
-  /// background [0-1].
-  double band_inside = 0.5;
+  /// background [0-1]. 1: the background is never bent.
+  double band_inside = 1.0;
+  /// The band's outer edge moves this many mesh-cell diagonals further
+  /// inside the outline. Pixels are interpolated from their cell's four
+  /// vertices, so a cell that reaches past the outline bends the background
+  /// beside the subject unless all its vertices follow the background
+  /// layer; 1 (with band_inside 1) keeps every pixel outside the outline on
+  /// the background layer [cells].
+  double outline_margin_cells = 1.0;
   /// Cap on the layer offset the band absorbs, measured at the head centre,
   /// as a fraction of the band's width [-]: the band's local stretch stays
   /// below about 1.5x this (the smoothstep's steepest slope). Beyond it one
@@ -33,8 +40,11 @@ struct LayerBlendOptions {
   /// "Slow": a critically damped type-2 tracking loop at this natural
   /// frequency (ramps pass without lag) followed by a first-order low-pass
   /// at 5x it (the loop alone passes about 2 f / f_motion of faster
-  /// motion). 0 = off (the band absorbs the whole offset) [Hz].
-  double offset_lowpass_hz = 0.1;
+  /// motion). It moves the background with the face, so it is off by
+  /// default: the head target keeps the offset within the band's reach
+  /// (StabilizerOptions::subject_reach) instead. 0 = off (the band absorbs
+  /// the whole offset) [Hz].
+  double offset_lowpass_hz = 0.0;
   /// Data-term weight of the band's vertices (those in the core and beyond
   /// the band are held at their layer) [-].
   double band_data_weight = 0.02;
@@ -55,10 +65,10 @@ struct LayerBlendOptions {
   /// face first, as the global mode): the whole frame follows the subject
   /// layer in part, so the core always shows the subject layer's pose and
   /// the background steadies less; at full yield the mesh is the subject
-  /// layer's, one global warp with the global mode's pose. false: the
-  /// subject follows the background layer in part (the head steadies less;
-  /// on the shake preset 71.5 px against global's 49.4).
-  bool yield_to_subject = true;
+  /// layer's, one global warp with the global mode's pose. false (the
+  /// default: the background is never moved by the face): the subject
+  /// follows the background layer in part (the head steadies less).
+  bool yield_to_subject = false;
 };
 
 Status ValidateLayerBlendOptions(const LayerBlendOptions& options);
@@ -164,6 +174,7 @@ class LayerBlend {
 
   int cols_ = 0, rows_ = 0;
   std::vector<double> u_, v_;
+  double cell_diagonal_ = 0.0;  // the largest cell's diagonal [output px]
   LayerBlendOptions options_;
   Eigen::SparseMatrix<double> shape_;   // w_s S^T S
   Eigen::SparseMatrix<double> system_;  // the band's unknowns only

@@ -26,7 +26,9 @@ struct SubjectRegionOptions {
   double shoulder_width_scale = 1.5;
   /// Neck half-width over the jaw width [-].
   double neck_width_scale = 0.35;
-  /// Time constant of the region's smoothing (centre and size) [s].
+  /// Time constant of the region's shape smoothing (its size and the chin's
+  /// place on it; the position is each frame's, so a moving subject does not
+  /// lag into the band) [s].
   double smoothing_s = 0.15;
   /// The blend weight moves by at most dt / ramp_s per frame: the warp
   /// returns to one global warp (or leaves it) over at least this time [s].

@@ -18,6 +18,7 @@
 #include "steadiface_core/stabilizer/stabilizer_options.h"
 #include "steadiface_core/status.h"
 #include "steadiface_core/time.h"
+#include "steadiface_core/tracking_lowpass.h"
 
 namespace steadiface {
 
@@ -204,11 +205,12 @@ class Stabilizer {
   // `world_face`, this frame's usable face as the reference camera sees it
   // (null when there is none).
   // H within options_.subject_reach of where the background layer (solved
-  // before, in f->background) shows the face.
-  void HoldWithinBackgroundReach(const FaceObservation& face, StabilizerFrame* f) const;
+  // before, in f->background) shows the face, and within the hold of that
+  // position's slow part (reach_anchor_); `dt` [s] since the last frame.
+  void HoldWithinBackgroundReach(const FaceObservation& face, double dt, StabilizerFrame* f);
   void HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face,
                       const FaceObservation* world_face, const StabilizerWeights& w,
-                      const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
+                      const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0, double dt,
                       StabilizerFrame* f);
   // Solve (Eq. 5) from the initial pose in *R_v, *t; the solution replaces
   // it when usable.
@@ -252,6 +254,12 @@ class Stabilizer {
   // the fade-out after a loss.
   bool has_held_face_ = false;
   FaceObservation held_face_;
+  // The slow part of where the background layer shows the face
+  // (subject_reach_lowpass_hz), and the frame (stats_.frames) it was last
+  // fed: it restarts after a frame without it.
+  SlowMotionFilter reach_anchor_;
+  uint64_t reach_anchor_frame_ = 0;
+  bool reach_anchor_fed_ = false;
 };
 
 }  // namespace steadiface

@@ -140,12 +140,23 @@ struct StabilizerOptions {
   /// the paper's term (towards the previous virtual rotation).
   double intentional_window_s = 0.0;
   /// With the background layer on: Eq. 1's H is held within this reach of
-  /// where the background layer shows the face (per axis), in jaw widths of
+  /// where the background layer shows the face (a disc), in jaw widths of
   /// the face [-], so the offset between the layers at the head stays
   /// within what a transition band can absorb and the background layer is
   /// never moved by the face. The background layer is solved first. 0 =
   /// off (H is not constrained by the background layer).
   double subject_reach = 0.0;
+  /// With subject_reach: H follows the slow part of where the background
+  /// layer shows the face (the head's drift in the steady scene, as a
+  /// viewer expects), low-passed at this frequency by a tracking loop that
+  /// follows ramps without lag (TrackingLowpass), so the reach is spent on
+  /// the face's fast motion rather than on its drift [Hz]. 0 = H is held
+  /// within the reach of the face itself.
+  double subject_reach_lowpass_hz = 0.2;
+  /// With subject_reach_lowpass_hz: the fraction of the reach by which
+  /// Eq. 1's H may stay away from that slow part (holding still against the
+  /// drift); the rest of the reach is left for the face's fast motion [0-1].
+  double subject_reach_hold = 0.5;
 };
 
 Status ValidateStabilizerWeights(const StabilizerWeights& weights);
