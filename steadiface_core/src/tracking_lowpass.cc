@@ -62,10 +62,13 @@ const Eigen::Vector2d& SlowMotionFilter::Update(const Eigen::Vector2d& x, double
   velocity_ += K(1) * innovation;
   const Eigen::Matrix2d P = P_;
   P_ = P - K * P.row(0);
-  // The first-order stage, led by the velocity.
+  // The first-order stage, led by the velocity times its lag on a ramp
+  // (for the sampled stage y += (1 - a)(x - y), a = exp(-dt / tau), that lag
+  // is dt a / (1 - a), about tau - dt / 2).
   constexpr double post_ratio = 5.0;
-  const double tau = 1.0 / (post_ratio * wn);
-  smooth_ += (1.0 - std::exp(-dt / tau)) * (position_ + velocity_ * tau - smooth_);
+  const double a = std::exp(-dt * post_ratio * wn);
+  const double lead = dt * a / (1.0 - a);
+  smooth_ += (1.0 - a) * (position_ + velocity_ * lead - smooth_);
   return smooth_;
 }
 

@@ -11,7 +11,7 @@
 
 namespace steadiface {
 
-/// Shape and dynamics of the subject region of the layered warp (issue 15):
+/// Shape and dynamics of the subject region of the layered warp:
 /// the part of the output that follows the face-following (subject) layer.
 /// Lengths are relative to the face as the 68 landmarks see it: the jaw
 /// width (landmarks 0-16) and the brow-to-chin height.
