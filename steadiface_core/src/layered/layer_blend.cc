@@ -154,129 +154,21 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     return;
   }
   r.layered = true;
-  // Output px per input px, from the background mesh's middle row.
-  double in_per_out = 0.0;
-  {
-    const int j = rows_ / 2;
-    double sum = 0.0, span = 0.0;
-    for (int i = 0; i + 1 < cols_; ++i) {
-      sum += (background[j * cols_ + i + 1] - background[j * cols_ + i])
-                 .cast<double>()
-                 .norm();
-      span += u_[i + 1] - u_[i];
-    }
-    in_per_out = span > 0 ? sum / span : 1.0;
-  }
-  // Blend weight and data weight per vertex.
-  // The band runs from band_inside * B inside the outline to the rest of B
-  // outside it.
-  const double B = std::max(1.0, options_.band_width * region.jaw_width);
-  const double outer =
-      (1.0 - options_.band_inside) * B - options_.outline_margin_cells * cell_diagonal_;
-  r.band_px = B;
-  r.band_outer_px = outer;
-  std::vector<bool> free_vertex(n);
-  for (int k = 0; k < n; ++k) {
-    const double dist =
-        region.SignedDistance(Eigen::Vector2d(u_[k % cols_], v_[k / cols_]));
-    const double s = std::min(1.0, std::max(0.0, (outer - dist) / B));
-    alpha_[k] = region.blend * s * s * (3.0 - 2.0 * s);
-    free_vertex[k] = s > 0.0 && s < 1.0;
-  }
-  // Layer offset at the head centre (bilinear in the vertex grid), its slow
-  // part (a shift of the whole frame), and the cap on the rest.
-  Eigen::Vector2d shift = Eigen::Vector2d::Zero(),
-                  fast = Eigen::Vector2d::Zero();
-  {
-    const Eigen::Vector2d h = region.head_centre;
-    int i = 0, j = 0;
-    while (i + 2 < cols_ && u_[i + 1] < h.x()) ++i;
-    while (j + 2 < rows_ && v_[j + 1] < h.y()) ++j;
-    const double a =
-        std::min(1.0, std::max(0.0, (h.x() - u_[i]) / (u_[i + 1] - u_[i])));
-    const double b =
-        std::min(1.0, std::max(0.0, (h.y() - v_[j]) / (v_[j + 1] - v_[j])));
-    auto D = [&](int ii, int jj) {
-      const int k = jj * cols_ + ii;
-      return (subject[k] - background[k]).cast<double>().eval();
-    };
-    const Eigen::Vector2d Dc =
-        (1 - a) * (1 - b) * D(i, j) + a * (1 - b) * D(i + 1, j) +
-        (1 - a) * b * D(i, j + 1) + a * b * D(i + 1, j + 1);
-    // The slow part of the offset moves the whole frame (a type-2 tracking
-    // loop: no lag on ramps such as a pan); the band absorbs the rest.
-    if (options_.offset_lowpass_hz <= 0.0) {
-      smooth_.setZero();
-    } else {
-      smooth_ = offset_lowpass_.Update(Dc, dt);
-    }
-    shift = region.blend * smooth_;
-    fast = Dc - smooth_;
-    r.offset_px = region.blend * fast.norm() / in_per_out;
-  }
-  double cap = 1.0;
-  const double max_offset_px = options_.max_offset * B;
-  if (max_offset_px > 0 && r.offset_px > max_offset_px)
-    cap = max_offset_px / r.offset_px;
-  r.capped_offset_px = r.offset_px * cap;
-  // Yielding to the subject, what the cap takes from the band moves the
-  // whole frame instead: the core still follows the subject layer.
-  if (options_.yield_to_subject) shift += region.blend * (1.0 - cap) * fast;
-  r.shift_px = shift.norm() / in_per_out;
+  const double in_per_out = InputPerOutput(background);
+  std::vector<bool> free_vertex;
+  BandWeights(region, &free_vertex, &r);
+  Eigen::Vector2d shift, fast;
+  const double cap = SplitHeadOffset(subject, background, region, dt, in_per_out, &shift,
+                                     &fast, &r);
   // Targets T_k. Vertices in the core and beyond the band are held at
   // their targets (their data terms dominate: they follow their layer);
-  // only the band's vertices are unknowns of the least-squares problem
-  // (fixed vertices enter its right-hand side through the shape term).
-  const double wt = has_previous_ ? options_.temporal_weight : 0.0;
+  // only the band's vertices are unknowns of the least-squares problem.
   Eigen::VectorXd target(2 * n);
   for (int k = 0; k < n; ++k) {
     const Eigen::Vector2d D = (subject[k] - background[k]).cast<double>();
     target.segment<2>(2 * k) = shift + alpha_[k] * cap * (D - smooth_);
   }
-  Eigen::VectorXd d = target;
-  free_.assign(2 * n, -1);
-  int m = 0;
-  for (int k = 0; k < n; ++k) {
-    if (free_vertex[k]) {
-      free_[2 * k] = m++;
-      free_[2 * k + 1] = m++;
-    }
-  }
-  if (m > 0) {
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(m);
-    triplets_.clear();
-    for (int col = 0; col < shape_.outerSize(); ++col) {
-      const int fc = free_[col];
-      for (Eigen::SparseMatrix<double>::InnerIterator it(shape_, col); it;
-           ++it) {
-        const int fr = free_[it.row()];
-        if (fr < 0) continue;
-        if (fc >= 0) {
-          triplets_.emplace_back(fr, fc, it.value());
-        } else {
-          rhs(fr) -= it.value() * target(col);  // a held neighbour
-        }
-      }
-    }
-    for (int q = 0; q < 2 * n; ++q) {
-      const int f = free_[q];
-      if (f < 0) continue;
-      // Temporal: the correction d - T changes slowly (not d itself, which
-      // must follow the subject without lag).
-      const double wd = options_.band_data_weight;
-      triplets_.emplace_back(f, f, wd + wt);
-      rhs(f) += wd * target(q) + wt * (target(q) + e_previous_(q));
-    }
-    system_.resize(m, m);
-    system_.setFromTriplets(triplets_.begin(), triplets_.end());
-    solver_.compute(system_);
-    const Eigen::VectorXd x = solver_.solve(rhs);
-    if (solver_.info() == Eigen::Success && x.allFinite()) {
-      for (int q = 0; q < 2 * n; ++q) {
-        if (free_[q] >= 0) d(q) = x(free_[q]);
-      }
-    }  // else (cannot happen for this SPD system) the plain blend T stays
-  }
+  Eigen::VectorXd d = SolveBand(target, free_vertex);
   // The pulls below scale d's departure from the layer that does not give
   // way: d_k = base_k + s (d_k - base_k), with base 0 (the background
   // layer) or, yielding to the subject, g D_k (the background layer moved
@@ -285,11 +177,9 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   Eigen::VectorXd base = Eigen::VectorXd::Zero(2 * n);
   if (options_.yield_to_subject) {
     for (int k = 0; k < n; ++k) {
-      base.segment<2>(2 * k) =
-          region.blend * (subject[k] - background[k]).cast<double>();
+      base.segment<2>(2 * k) = region.blend * (subject[k] - background[k]).cast<double>();
     }
   }
-  Eigen::VectorXd departure = d - base;
   // The base mesh's vertices and how far each lies outside the input frame
   // (the pulls and the final clamp allow a vertex that much).
   const double w1 = input_width - 1.0, h1 = input_height - 1.0;
@@ -299,61 +189,214 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     base_mesh[k] = background[k].cast<double>() + base.segment<2>(2 * k);
     base_excess[k] = Excess(base_mesh[k], w1, h1);
   }
-  // No undefined pixels: scale d towards the base if a vertex leaves the
-  // input frame (more than the base's own vertex does).
+  Eigen::VectorXd departure = d - base;
+  r.protrusion_keep = PullInsideFrame(base_mesh, base_excess, w1, h1, &departure);
+  if (r.protrusion_keep < 1.0) d = base + departure;
+  if (options_.min_cell_ratio > 0.0) {
+    const double keep = PullUnsqueezed(base_mesh, departure);
+    if (keep < 1.0) {
+      r.distortion_keep = keep;
+      d = base + keep * departure;
+    }
+  }
+  WriteMesh(background, region, d, base_excess, w1, h1, source, &r);
+  e_previous_ = d - target;
+  // Distortion of the result.
+  MeasureCells(*source, &r);
+  std::vector<double> added;
+  CellRatios(cols_, rows_, u_, v_, *source, &background, &added);
+  if (!added.empty()) r.min_added_ratio = *std::min_element(added.begin(), added.end());
+  r.solve_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  *report = r;
+}
+
+double LayerBlend::InputPerOutput(const std::vector<Eigen::Vector2f>& background) const {
+  // Output px per input px, from the background mesh's middle row.
+  const int j = rows_ / 2;
+  double sum = 0.0, span = 0.0;
+  for (int i = 0; i + 1 < cols_; ++i) {
+    sum += (background[j * cols_ + i + 1] - background[j * cols_ + i]).cast<double>().norm();
+    span += u_[i + 1] - u_[i];
+  }
+  return span > 0 ? sum / span : 1.0;
+}
+
+void LayerBlend::BandWeights(const SubjectRegion& region, std::vector<bool>* free_vertex,
+                             LayerBlendReport* r) {
+  // The band runs from band_inside * B inside the outline to the rest of B
+  // outside it, moved outline_margin_cells cell diagonals further in.
+  const int n = cols_ * rows_;
+  const double B = std::max(1.0, options_.band_width * region.jaw_width);
+  const double outer =
+      (1.0 - options_.band_inside) * B - options_.outline_margin_cells * cell_diagonal_;
+  r->band_px = B;
+  r->band_outer_px = outer;
+  free_vertex->assign(n, false);
+  for (int k = 0; k < n; ++k) {
+    const double dist = region.SignedDistance(Eigen::Vector2d(u_[k % cols_], v_[k / cols_]));
+    const double s = std::min(1.0, std::max(0.0, (outer - dist) / B));
+    alpha_[k] = region.blend * s * s * (3.0 - 2.0 * s);
+    (*free_vertex)[k] = s > 0.0 && s < 1.0;
+  }
+}
+
+Eigen::Vector2d LayerBlend::OffsetAt(const std::vector<Eigen::Vector2f>& subject,
+                                     const std::vector<Eigen::Vector2f>& background,
+                                     const Eigen::Vector2d& h) const {
+  // Bilinear in the vertex grid.
+  int i = 0, j = 0;
+  while (i + 2 < cols_ && u_[i + 1] < h.x()) ++i;
+  while (j + 2 < rows_ && v_[j + 1] < h.y()) ++j;
+  const double a = std::min(1.0, std::max(0.0, (h.x() - u_[i]) / (u_[i + 1] - u_[i])));
+  const double b = std::min(1.0, std::max(0.0, (h.y() - v_[j]) / (v_[j + 1] - v_[j])));
+  auto D = [&](int ii, int jj) {
+    const int k = jj * cols_ + ii;
+    return (subject[k] - background[k]).cast<double>().eval();
+  };
+  return (1 - a) * (1 - b) * D(i, j) + a * (1 - b) * D(i + 1, j) + (1 - a) * b * D(i, j + 1) +
+         a * b * D(i + 1, j + 1);
+}
+
+double LayerBlend::SplitHeadOffset(const std::vector<Eigen::Vector2f>& subject,
+                                   const std::vector<Eigen::Vector2f>& background,
+                                   const SubjectRegion& region, double dt, double in_per_out,
+                                   Eigen::Vector2d* shift, Eigen::Vector2d* fast,
+                                   LayerBlendReport* r) {
+  const Eigen::Vector2d Dc = OffsetAt(subject, background, region.head_centre);
+  // The slow part of the offset moves the whole frame (a type-2 tracking
+  // loop: no lag on ramps such as a pan); the band absorbs the rest.
+  if (options_.offset_lowpass_hz <= 0.0) {
+    smooth_.setZero();
+  } else {
+    smooth_ = offset_lowpass_.Update(Dc, dt);
+  }
+  *shift = region.blend * smooth_;
+  *fast = Dc - smooth_;
+  r->offset_px = region.blend * fast->norm() / in_per_out;
+  double cap = 1.0;
+  const double max_offset_px = options_.max_offset * r->band_px;
+  if (max_offset_px > 0 && r->offset_px > max_offset_px) cap = max_offset_px / r->offset_px;
+  r->capped_offset_px = r->offset_px * cap;
+  // Yielding to the subject, what the cap takes from the band moves the
+  // whole frame instead: the core still follows the subject layer.
+  if (options_.yield_to_subject) *shift += region.blend * (1.0 - cap) * *fast;
+  r->shift_px = shift->norm() / in_per_out;
+  return cap;
+}
+
+Eigen::VectorXd LayerBlend::SolveBand(const Eigen::VectorXd& target,
+                                      const std::vector<bool>& free_vertex) {
+  // Fixed vertices enter the right-hand side through the shape term.
+  const int n = cols_ * rows_;
+  const double wt = has_previous_ ? options_.temporal_weight : 0.0;
+  Eigen::VectorXd d = target;
+  free_.assign(2 * n, -1);
+  int m = 0;
+  for (int k = 0; k < n; ++k) {
+    if (free_vertex[k]) {
+      free_[2 * k] = m++;
+      free_[2 * k + 1] = m++;
+    }
+  }
+  if (m == 0) return d;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(m);
+  triplets_.clear();
+  for (int col = 0; col < shape_.outerSize(); ++col) {
+    const int fc = free_[col];
+    for (Eigen::SparseMatrix<double>::InnerIterator it(shape_, col); it; ++it) {
+      const int fr = free_[it.row()];
+      if (fr < 0) continue;
+      if (fc >= 0) {
+        triplets_.emplace_back(fr, fc, it.value());
+      } else {
+        rhs(fr) -= it.value() * target(col);  // a held neighbour
+      }
+    }
+  }
+  for (int q = 0; q < 2 * n; ++q) {
+    const int f = free_[q];
+    if (f < 0) continue;
+    // Temporal: the correction d - T changes slowly (not d itself, which
+    // must follow the subject without lag).
+    const double wd = options_.band_data_weight;
+    triplets_.emplace_back(f, f, wd + wt);
+    rhs(f) += wd * target(q) + wt * (target(q) + e_previous_(q));
+  }
+  system_.resize(m, m);
+  system_.setFromTriplets(triplets_.begin(), triplets_.end());
+  solver_.compute(system_);
+  const Eigen::VectorXd x = solver_.solve(rhs);
+  if (solver_.info() == Eigen::Success && x.allFinite()) {
+    for (int q = 0; q < 2 * n; ++q) {
+      if (free_[q] >= 0) d(q) = x(free_[q]);
+    }
+  }  // else (cannot happen for this SPD system) the plain blend T stays
+  return d;
+}
+
+double LayerBlend::PullInsideFrame(const std::vector<Eigen::Vector2d>& base_mesh,
+                                   const std::vector<double>& base_excess, double w1, double h1,
+                                   Eigen::VectorXd* departure) const {
+  // No undefined pixels: scale the departure towards the base if a vertex
+  // leaves the input frame (more than the base's own vertex does).
+  const int n = cols_ * rows_;
   auto feasible = [&](double s) {
     for (int k = 0; k < n; ++k) {
-      if (Excess(base_mesh[k] + s * departure.segment<2>(2 * k), w1, h1) >
+      if (Excess(base_mesh[k] + s * departure->segment<2>(2 * k), w1, h1) >
           base_excess[k] + 1e-3)
         return false;
     }
     return true;
   };
-  double keep = 1.0;
-  if (!feasible(1.0)) {
-    double lo = 0.0, hi = 1.0;
-    for (int it = 0; it < 12; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (feasible(mid) ? lo : hi) = mid;
-    }
-    keep = lo;
-    departure *= keep;
-    d = base + departure;
+  if (feasible(1.0)) return 1.0;
+  double lo = 0.0, hi = 1.0;
+  for (int it = 0; it < 12; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (feasible(mid) ? lo : hi) = mid;
   }
-  r.protrusion_keep = keep;
-  // No squeezed cell: scale d further towards the base while a cell's ratio
-  // is below the floor (or below the base's own ratio for that cell, where
-  // that is lower already). At scale 0 every cell is the base's, so the
-  // bisection's lower end is always allowed.
-  if (options_.min_cell_ratio > 0.0) {
-    std::vector<Eigen::Vector2f> scaled(n);
-    for (int k = 0; k < n; ++k) scaled[k] = base_mesh[k].cast<float>();
-    std::vector<double> floor_ratio;
-    CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &floor_ratio);
-    for (double& q : floor_ratio) q = std::min(q, options_.min_cell_ratio);
-    std::vector<double> ratios;
-    auto unsqueezed = [&](double s) {
-      for (int k = 0; k < n; ++k) {
-        scaled[k] =
-            (base_mesh[k] + s * departure.segment<2>(2 * k)).cast<float>();
-      }
-      CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &ratios);
-      for (size_t q = 0; q < ratios.size(); ++q) {
-        if (ratios[q] < floor_ratio[q] - 1e-4) return false;
-      }
-      return true;
-    };
-    if (!unsqueezed(1.0)) {
-      double lo = 0.0, hi = 1.0;
-      for (int it = 0; it < 12; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (unsqueezed(mid) ? lo : hi) = mid;
-      }
-      r.distortion_keep = lo;
-      d = base + lo * departure;
+  *departure *= lo;
+  return lo;
+}
+
+double LayerBlend::PullUnsqueezed(const std::vector<Eigen::Vector2d>& base_mesh,
+                                  const Eigen::VectorXd& departure) const {
+  // No squeezed cell: the largest scale of the departure at which no cell's
+  // ratio is below the floor (or below the base's own ratio for that cell,
+  // where that is lower already). At scale 0 every cell is the base's, so
+  // the bisection's lower end is always allowed.
+  const int n = cols_ * rows_;
+  std::vector<Eigen::Vector2f> scaled(n);
+  for (int k = 0; k < n; ++k) scaled[k] = base_mesh[k].cast<float>();
+  std::vector<double> floor_ratio;
+  CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &floor_ratio);
+  for (double& q : floor_ratio) q = std::min(q, options_.min_cell_ratio);
+  std::vector<double> ratios;
+  auto unsqueezed = [&](double s) {
+    for (int k = 0; k < n; ++k) {
+      scaled[k] = (base_mesh[k] + s * departure.segment<2>(2 * k)).cast<float>();
     }
+    CellRatios(cols_, rows_, u_, v_, scaled, nullptr, &ratios);
+    for (size_t q = 0; q < ratios.size(); ++q) {
+      if (ratios[q] < floor_ratio[q] - 1e-4) return false;
+    }
+    return true;
+  };
+  if (unsqueezed(1.0)) return 1.0;
+  double lo = 0.0, hi = 1.0;
+  for (int it = 0; it < 12; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (unsqueezed(mid) ? lo : hi) = mid;
   }
+  return lo;
+}
+
+void LayerBlend::WriteMesh(const std::vector<Eigen::Vector2f>& background,
+                           const SubjectRegion& region, const Eigen::VectorXd& d,
+                           const std::vector<double>& base_excess, double w1, double h1,
+                           std::vector<Eigen::Vector2f>* source, LayerBlendReport* r) {
   // Band vertex flicker, then the final mesh.
+  const int n = cols_ * rows_;
   double step2 = 0.0;
   int band = 0;
   for (int k = 0; k < n; ++k) {
@@ -370,20 +413,9 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
                                   .cwiseMin(Eigen::Vector2d(w1 + ex, h1 + ex));
     (*source)[k] = q.cast<float>();
   }
-  r.band_vertex_step_px = band > 0 ? std::sqrt(step2 / band) : 0.0;
+  r->band_vertex_step_px = band > 0 ? std::sqrt(step2 / band) : 0.0;
   d_previous_ = d;
-  e_previous_ = d - target;
   has_previous_ = true;
-  // Distortion of the result.
-  MeasureCells(*source, &r);
-  std::vector<double> added;
-  CellRatios(cols_, rows_, u_, v_, *source, &background, &added);
-  if (!added.empty())
-    r.min_added_ratio = *std::min_element(added.begin(), added.end());
-  r.solve_ms = std::chrono::duration<double, std::milli>(
-                   std::chrono::steady_clock::now() - start)
-                   .count();
-  *report = r;
 }
 
 void LayerBlend::MeasureCells(const std::vector<Eigen::Vector2f>& source,

@@ -167,6 +167,41 @@ class LayerBlend {
   }
 
  private:
+  // Output px per input px, from the background mesh's middle row.
+  double InputPerOutput(const std::vector<Eigen::Vector2f>& background) const;
+  // Each vertex's blend weight a_k into alpha_, whether it is a band vertex
+  // (an unknown), and the band's width and outer edge into *r.
+  void BandWeights(const SubjectRegion& region, std::vector<bool>* free_vertex,
+                   LayerBlendReport* r);
+  // The layer offset subject - background at output point h (bilinear).
+  Eigen::Vector2d OffsetAt(const std::vector<Eigen::Vector2f>& subject,
+                           const std::vector<Eigen::Vector2f>& background,
+                           const Eigen::Vector2d& h) const;
+  // The offset at the head centre split into the whole frame's shift (its
+  // slow part, and what the cap leaves when yielding to the subject) and
+  // the fast part the band absorbs; returns the cap's scale [0-1].
+  double SplitHeadOffset(const std::vector<Eigen::Vector2f>& subject,
+                         const std::vector<Eigen::Vector2f>& background,
+                         const SubjectRegion& region, double dt, double in_per_out,
+                         Eigen::Vector2d* shift, Eigen::Vector2d* fast, LayerBlendReport* r);
+  // The least-squares solve over the band's vertices; the rest keep their
+  // targets.
+  Eigen::VectorXd SolveBand(const Eigen::VectorXd& target, const std::vector<bool>& free_vertex);
+  // The no-undefined-pixels pull: scales *departure by the largest factor
+  // that keeps every vertex in the frame (or no farther out than the
+  // base's); returns it.
+  double PullInsideFrame(const std::vector<Eigen::Vector2d>& base_mesh,
+                         const std::vector<double>& base_excess, double w1, double h1,
+                         Eigen::VectorXd* departure) const;
+  // The no-squeezed-cell pull: the largest scale of `departure` that keeps
+  // every cell's ratio at min_cell_ratio (or the base's own, if lower).
+  double PullUnsqueezed(const std::vector<Eigen::Vector2d>& base_mesh,
+                        const Eigen::VectorXd& departure) const;
+  // The final mesh from the offsets d (clamped to the frame), the band's
+  // flicker into *r, and d kept for the next frame.
+  void WriteMesh(const std::vector<Eigen::Vector2f>& background, const SubjectRegion& region,
+                 const Eigen::VectorXd& d, const std::vector<double>& base_excess, double w1,
+                 double h1, std::vector<Eigen::Vector2f>* source, LayerBlendReport* r);
   // Cell ratios of `source` into ratios_scratch_; folds, worst and 1st
   // percentile into *r.
   void MeasureCells(const std::vector<Eigen::Vector2f>& source,
