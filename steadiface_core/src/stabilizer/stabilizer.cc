@@ -402,9 +402,21 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
   const Eigen::Vector2d t0 = *t;
   pp->q() = R_v0.coeffs();
   pp->t() = t0;
+  ceres_compat::AddQuaternionBlock(&pp->problem, pp->q_block);
+  pp->problem.AddParameterBlock(pp->t_block, 2);
+  AddFitTerms(fit_face, w, *f, pp);
+  AddRotationTerms(stamp, timeline, timing, layer, w, dt, *f, pp);
+  AddOffsetTerms(layer, w, R_v0, t0, *f, pp);
+  RunSolve(R_v0, t0, pp, R_v, t, f, stats);
+  f->solver.time_ms = MsSince(t_solve);
+  f->timings.solve_ms = f->solver.time_ms;
+}
+
+void Stabilizer::AddFitTerms(const FaceObservation* fit_face, const StabilizerWeights& w,
+                             const StabilizerFrame& frame, PoseProblem* pp) const {
+  // E_f (Eq. 6), one block per landmark, each through its own row.
+  const StabilizerFrame* f = &frame;
   ceres::Problem& problem = pp->problem;
-  ceres_compat::AddQuaternionBlock(&problem, pp->q_block);
-  problem.AddParameterBlock(pp->t_block, 2);
   const double f_r = model_.real_focal(), f_v = model_.virtual_focal();
   if (f->has_target && w.fit > 0.0) {
     const FaceObservation* face = fit_face;
@@ -419,6 +431,15 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
           nullptr, pp->q_block, pp->t_block));
     }
   }
+}
+
+void Stabilizer::AddRotationTerms(Time stamp, const OrientationTimeline& timeline,
+                                  const RowTiming& timing, const LayerState& layer,
+                                  const StabilizerWeights& w, double dt,
+                                  const StabilizerFrame& frame, PoseProblem* pp) const {
+  // E_d (Eq. 7), E_o (Eq. 8) and E_r (Eq. 9).
+  const StabilizerFrame* f = &frame;
+  ceres::Problem& problem = pp->problem;
   if (w.distortion > 0.0) {
     pp->b_dist.push_back(problem.AddResidualBlock(
         DistortionCost::Create(f->R_r, options_.terms.distortion_threshold_rad,
@@ -451,6 +472,14 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
                                        std::sqrt(w.rotation_c1)),
         nullptr, pp->q_block));
   }
+}
+
+void Stabilizer::AddOffsetTerms(const LayerState& layer, const StabilizerWeights& w,
+                                const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
+                                const StabilizerFrame& frame, PoseProblem* pp) {
+  // E_t (Eq. 10) and E_p (Eq. 11, at the initial pose's rows).
+  const StabilizerFrame* f = &frame;
+  ceres::Problem& problem = pp->problem;
   // On the first frame the offset's only prior is C0 towards 0.
   pp->b_trans.push_back(problem.AddResidualBlock(
       TranslationSmoothnessCost::Create(
@@ -472,6 +501,12 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
         nullptr, pp->q_block, pp->t_block));
   }
 
+}
+
+void Stabilizer::RunSolve(const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
+                          PoseProblem* pp, Eigen::Quaterniond* R_v, Eigen::Vector2d* t,
+                          StabilizerFrame* f, StabilizerStats* stats) const {
+  ceres::Problem& problem = pp->problem;
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = options_.solver.max_iterations;
@@ -504,7 +539,6 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
   const Eigen::Vector2d t_sol = pp->t();
   f->solver.usable = summary.IsSolutionUsable() && q_sol.coeffs().allFinite() &&
                      t_sol.allFinite() && std::isfinite(summary.final_cost);
-  f->solver.time_ms = MsSince(t_solve);
   if (f->solver.usable) {
     *R_v = q_sol.normalized();
     *t = t_sol;
@@ -512,7 +546,6 @@ void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
     f->flags.solver_failed = true;
     ++stats->solver_failures;
   }
-  f->timings.solve_ms = f->solver.time_ms;
 }
 
 void Stabilizer::ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v,

@@ -219,6 +219,20 @@ class Stabilizer {
                  const StabilizerWeights& w, double dt, PoseProblem* problem,
                  Eigen::Quaterniond* R_v, Eigen::Vector2d* t, StabilizerFrame* f,
                  StabilizerStats* stats);
+  // SolveStep's pieces: the residual blocks of E_f (Eq. 6); of E_d, E_o
+  // and E_r (Eqs. 7-9); of E_t and E_p (Eqs. 10-11); then the solve (the
+  // solution replaces *R_v, *t when usable).
+  void AddFitTerms(const FaceObservation* fit_face, const StabilizerWeights& w,
+                   const StabilizerFrame& f, PoseProblem* problem) const;
+  void AddRotationTerms(Time stamp, const OrientationTimeline& timeline, const RowTiming& timing,
+                        const LayerState& layer, const StabilizerWeights& w, double dt,
+                        const StabilizerFrame& f, PoseProblem* problem) const;
+  void AddOffsetTerms(const LayerState& layer, const StabilizerWeights& w,
+                      const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
+                      const StabilizerFrame& f, PoseProblem* problem);
+  void RunSolve(const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0, PoseProblem* problem,
+                Eigen::Quaterniond* R_v, Eigen::Vector2d* t, StabilizerFrame* f,
+                StabilizerStats* stats) const;
   // Protrusion search towards the real pose, else the previous warp.
   void ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v, Eigen::Vector2d* t,
                       StabilizerFrame* f, StabilizerStats* stats);
