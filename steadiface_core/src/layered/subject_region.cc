@@ -64,11 +64,12 @@ double SubjectRegion::SignedDistance(const Eigen::Vector2d& p) const {
   return d;
 }
 
-const SubjectRegion& SubjectRegionTracker::Update(
-    const CameraModel& model, const OutputGeometry& output,
-    const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
-    const RowRotations& rows, const FaceObservation* face, double blend_target,
-    double dt) {
+SubjectRegion SubjectRegionTracker::Measure(const CameraModel& model,
+                                            const OutputGeometry& output,
+                                            const Eigen::Quaterniond& R_v,
+                                            const Eigen::Vector2d& t, const RowRotations& rows,
+                                            const FaceObservation* face) const {
+  // This frame's head ellipse from the landmarks (invalid without them).
   const SubjectRegionOptions& o = options_;
   SubjectRegion measured;
   if (face != nullptr && face->valid && face->landmarks.size() == 68 &&
@@ -110,6 +111,16 @@ const SubjectRegion& SubjectRegionTracker::Update(
       }
     }
   }
+  return measured;
+}
+
+const SubjectRegion& SubjectRegionTracker::Update(
+    const CameraModel& model, const OutputGeometry& output,
+    const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+    const RowRotations& rows, const FaceObservation* face, double blend_target,
+    double dt) {
+  const SubjectRegionOptions& o = options_;
+  const SubjectRegion measured = Measure(model, output, R_v, t, rows, face);
   SubjectRegion& r = region_;
   if (measured.valid) {
     if (!r.valid) {

@@ -86,6 +86,11 @@ class SubjectRegionTracker {
   void reset() { region_ = SubjectRegion(); }
 
  private:
+  // This frame's region from the landmarks, unsmoothed (invalid without a
+  // usable face).
+  SubjectRegion Measure(const CameraModel& model, const OutputGeometry& output,
+                        const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
+                        const RowRotations& rows, const FaceObservation* face) const;
   const SubjectRegionOptions options_;
   SubjectRegion region_;
 };
