@@ -237,6 +237,16 @@ void Scorecard::Add(int index, const FrameWarp& w) {
   if (w.kind != FrameWarp::Kind::kIdentity) identity_ = false;
   head_target_out_.push_back(w.has_head_target ? output_.VirtualToOutputPixel(w.head_target)
                                                : Eigen::Vector2d::Constant(NAN));
+  AddVisibleBackground(index, w);
+  if (w.kind == FrameWarp::Kind::kMesh) AddMesh(index, w);
+  distortion_.push_back(CentreDistortion(w));
+  undefined_ += Undefined(w, &s);
+  AddStageTimes(w);
+  samples_.push_back(s);
+}
+
+void Scorecard::AddVisibleBackground(int index, const FrameWarp& w) {
+  const CameraIntrinsics& ki = sim_.intrinsics();
   // Visible background and straight lines: input pixels the subject does
   // not cover, landing inside the output image.
   const double ow = w.kind == FrameWarp::Kind::kIdentity ? ki.width : output_.width();
@@ -276,38 +286,42 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     }
     flush();
   }
-  if (w.kind == FrameWarp::Kind::kMesh) {
-    const int cols = static_cast<int>(w.mesh_u.size()), rows = static_cast<int>(w.mesh_v.size());
-    std::vector<double> ratios;
-    folded_ += CellRatios(cols, rows, w.mesh_u, w.mesh_v, w.mesh_source, nullptr, &ratios);
-    cell_ratios_.insert(cell_ratios_.end(), ratios.begin(), ratios.end());
-    for (double q : ratios) {
-      if (q < min_ratio_) {
-        min_ratio_ = q;
-        min_ratio_frame_ = index;
-      }
-    }
-    const size_t n = w.mesh_source.size();
-    if (w.mesh_background.size() == n && w.mesh_blend.size() == n) {
-      // Output px per input px, from the background mesh's middle row.
-      const int j = rows / 2;
-      double sum = 0.0, span = 0.0;
-      for (int i = 0; i + 1 < cols; ++i) {
-        sum += (w.mesh_background[j * cols + i + 1] - w.mesh_background[j * cols + i])
-                   .cast<double>().norm();
-        span += w.mesh_u[i + 1] - w.mesh_u[i];
-      }
-      const double zoom = sum > 0 ? span / sum : 1.0;
-      const double g = *std::max_element(w.mesh_blend.begin(), w.mesh_blend.end());
-      band_offsets_.resize(n);
-      band_frames_.resize(n, 0);
-      for (size_t k = 0; k < n; ++k) {
-        band_offsets_[k].push_back(zoom * (w.mesh_source[k] - w.mesh_background[k]).cast<double>());
-        if (w.mesh_blend[k] > 0.0 && w.mesh_blend[k] < 0.999 * g) ++band_frames_[k];
-      }
+}
+
+void Scorecard::AddMesh(int index, const FrameWarp& w) {
+  const int cols = static_cast<int>(w.mesh_u.size()), rows = static_cast<int>(w.mesh_v.size());
+  std::vector<double> ratios;
+  folded_ += CellRatios(cols, rows, w.mesh_u, w.mesh_v, w.mesh_source, nullptr, &ratios);
+  cell_ratios_.insert(cell_ratios_.end(), ratios.begin(), ratios.end());
+  for (double q : ratios) {
+    if (q < min_ratio_) {
+      min_ratio_ = q;
+      min_ratio_frame_ = index;
     }
   }
-  // Distortion: local linear part at the output centre, via the input point
+  const size_t n = w.mesh_source.size();
+  if (w.mesh_background.size() == n && w.mesh_blend.size() == n) {
+    // Output px per input px, from the background mesh's middle row.
+    const int j = rows / 2;
+    double sum = 0.0, span = 0.0;
+    for (int i = 0; i + 1 < cols; ++i) {
+      sum += (w.mesh_background[j * cols + i + 1] - w.mesh_background[j * cols + i])
+                 .cast<double>().norm();
+      span += w.mesh_u[i + 1] - w.mesh_u[i];
+    }
+    const double zoom = sum > 0 ? span / sum : 1.0;
+    const double g = *std::max_element(w.mesh_blend.begin(), w.mesh_blend.end());
+    band_offsets_.resize(n);
+    band_frames_.resize(n, 0);
+    for (size_t k = 0; k < n; ++k) {
+      band_offsets_[k].push_back(zoom * (w.mesh_source[k] - w.mesh_background[k]).cast<double>());
+      if (w.mesh_blend[k] > 0.0 && w.mesh_blend[k] < 0.999 * g) ++band_frames_[k];
+    }
+  }
+}
+
+double Scorecard::CentreDistortion(const FrameWarp& w) const {
+  // Local linear part at the output centre, via the input point
   // that lands there (numerically).
   double ratio = 1.0;
   if (w.kind != FrameWarp::Kind::kIdentity) {
@@ -326,8 +340,12 @@ void Scorecard::Add(int index, const FrameWarp& w) {
       ratio = 0.0;
     }
   }
-  distortion_.push_back(ratio);
-  // Undefined output pixels.
+  return ratio;
+}
+
+bool Scorecard::Undefined(const FrameWarp& w, Sample* s) const {
+  // Also fills the sample's pose figures (kPose).
+  const CameraIntrinsics& ki = sim_.intrinsics();
   bool undefined = false;
   if (w.kind == FrameWarp::Kind::kMesh) {
     // Bilinear cells: every pixel is defined when every vertex lands inside
@@ -342,10 +360,10 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     undefined = !protrusion_.Check(w.R_v, w.t, w.rows, 0.0).defined;
     const Eigen::Vector3d v = LogSO3(w.R_v), r = LogSO3(w.rows.Middle());
     for (int i = 0; i < 3; ++i) {
-      s.virtual_angle[i] = v[i];
-      s.real_angle[i] = r[i];
+      s->virtual_angle[i] = v[i];
+      s->real_angle[i] = r[i];
     }
-    s.offset = w.t;
+    s->offset = w.t;
   } else if (w.kind == FrameWarp::Kind::kHomography) {
     const Eigen::Matrix3d Hi = w.H.inverse();
     const double W = sim_.intrinsics().width - 1, Hh = sim_.intrinsics().height - 1;
@@ -358,7 +376,10 @@ void Scorecard::Add(int index, const FrameWarp& w) {
       }
     }
   }
-  undefined_ += undefined;
+  return undefined;
+}
+
+void Scorecard::AddStageTimes(const FrameWarp& w) {
   for (const auto& st : w.stage_ms) {
     auto it = std::find_if(stages_.begin(), stages_.end(),
                            [&](const auto& e) { return e.first == st.first; });
@@ -368,7 +389,6 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     }
     it->second.push_back(st.second);
   }
-  samples_.push_back(s);
 }
 
 std::vector<Eigen::Vector2d> Scorecard::LongestFiniteRun(const std::vector<Eigen::Vector2d>& x) {

@@ -153,6 +153,16 @@ class Scorecard {
   static std::vector<Eigen::Vector2d> LongestFiniteRun(const std::vector<Eigen::Vector2d>& x);
 
  private:
+  // Add's pieces: the visible background and the straight lines; a mesh's
+  // cells and its offsets from the background layer; the warp's
+  // distortion at the output centre; whether any output pixel is
+  // undefined (and, for a pose warp, its angles and offset into *s); the
+  // stage times.
+  void AddVisibleBackground(int index, const FrameWarp& w);
+  void AddMesh(int index, const FrameWarp& w);
+  double CentreDistortion(const FrameWarp& w) const;
+  bool Undefined(const FrameWarp& w, Sample* s) const;
+  void AddStageTimes(const FrameWarp& w);
   bool MapToOutput(const FrameWarp& w, const Eigen::Vector2d& in_px,
                    Eigen::Vector2d* out_px) const;
 
