@@ -108,29 +108,10 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   PipelineFrame f;
   // Face information.
   const auto t_face = std::chrono::steady_clock::now();
-  const FaceObservation* obs = nullptr;
   FaceObservation observation;
-  // The tracker and the check both work on grey: convert once (the same
-  // cv::cvtColor each would run, so their results do not change).
-  const bool internal_face =
-      tracker_ != nullptr && options_.landmark_source != LandmarkSource::kExternal;
-  const cv::Mat grey = internal_face ? ToGrey(image) : image;
-  if (tracker_ != nullptr) {
-    Status s;
-    if (options_.landmark_source == LandmarkSource::kExternal) {
-      static const std::vector<Eigen::Vector2d> kNone;
-      s = tracker_->ProcessExternal(external != nullptr ? *external : kNone,
-                                    external_confidence, stamp, &timeline_, &timing_,
-                                    &f.face);
-    } else {
-      s = tracker_->Process(grey, stamp, &timeline_, &timing_, &f.face);
-    }
-    // A face error never stops stabilization: it is a frame without a face.
-    if (f.face.valid) {
-      observation = f.face.ToObservation();
-      obs = &observation;
-    }
-  }
+  cv::Mat grey;
+  const FaceObservation* obs =
+      FaceStep(image, stamp, external, external_confidence, &grey, &observation, &f);
   f.timings.face_ms = MsSince(t_face);
   // The gyro-vs-video check (never changes the pose), outside the face.
   if (check_ != nullptr) {
@@ -144,7 +125,59 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   Status s = stabilizer_->Process(stamp, timeline_, timing_, obs, &f.stabilizer);
   f.timings.stabilizer_ms = MsSince(t_stab);
   if (!s.ok()) return s;
-  // Warp.
+  s = WarpStep(image, stamp, obs, &f);
+  if (s.ok() && defer_render_) {
+    f.mesh = warper_->mesh();
+    f.output_size = cv::Size(warper_->output_geometry().width(),
+                             warper_->output_geometry().height());
+  }
+  f.imu_offset_applied_s = timeline_.offset_correction();
+  if (check_ != nullptr && options_.gyro_video_check.apply_offset) ApplyOffsetEstimate(stamp);
+  if (!s.ok()) {
+    f.output.release();
+    *out = std::move(f);
+    return s;
+  }
+  f.timings.total_ms = MsSince(t0);
+  *out = std::move(f);
+  return Status::Ok();
+}
+
+const FaceObservation* Pipeline::FaceStep(const cv::Mat& image, Time stamp,
+                                          const std::vector<Eigen::Vector2d>* external,
+                                          double external_confidence, cv::Mat* grey_out,
+                                          FaceObservation* observation, PipelineFrame* f) {
+  const FaceObservation* obs = nullptr;
+  // The tracker and the check both work on grey: convert once (the same
+  // cv::cvtColor each would run, so their results do not change).
+  const bool internal_face =
+      tracker_ != nullptr && options_.landmark_source != LandmarkSource::kExternal;
+  *grey_out = internal_face ? ToGrey(image) : image;
+  const cv::Mat& grey = *grey_out;
+  if (tracker_ != nullptr) {
+    Status s;
+    if (options_.landmark_source == LandmarkSource::kExternal) {
+      static const std::vector<Eigen::Vector2d> kNone;
+      s = tracker_->ProcessExternal(external != nullptr ? *external : kNone,
+                                    external_confidence, stamp, &timeline_, &timing_,
+                                    &f->face);
+    } else {
+      s = tracker_->Process(grey, stamp, &timeline_, &timing_, &f->face);
+    }
+    // A face error never stops stabilization: it is a frame without a face.
+    if (f->face.valid) {
+      *observation = f->face.ToObservation();
+      obs = observation;
+    }
+  }
+  return obs;
+}
+
+Status Pipeline::WarpStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
+                          PipelineFrame* out) {
+  // The output: one pose warp, or the layered mesh from both layers.
+  PipelineFrame& f = *out;
+  Status s;
   const bool layered = options_.warp.mode == WarpMode::kLayered;
   const bool render = options_.render_output && !defer_render_;
   f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(
@@ -179,21 +212,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     s = warper_->ComputeMesh(f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows);
     f.timings.mesh_ms = warper_->timings().mesh_ms;
   }
-  if (s.ok() && defer_render_) {
-    f.mesh = warper_->mesh();
-    f.output_size = cv::Size(warper_->output_geometry().width(),
-                             warper_->output_geometry().height());
-  }
-  f.imu_offset_applied_s = timeline_.offset_correction();
-  if (check_ != nullptr && options_.gyro_video_check.apply_offset) ApplyOffsetEstimate(stamp);
-  if (!s.ok()) {
-    f.output.release();
-    *out = std::move(f);
-    return s;
-  }
-  f.timings.total_ms = MsSince(t0);
-  *out = std::move(f);
-  return Status::Ok();
+  return s;
 }
 
 Status Pipeline::ProcessFrameDeferred(const cv::Mat& image, Time stamp,

@@ -160,6 +160,16 @@ class Pipeline {
   const PipelineOptions& options() const { return options_; }
 
  private:
+  // ProcessFrame's pieces: the face (tracker or external landmarks; the
+  // grey image the tracker and the check share into *grey; returns the
+  // usable observation, stored in *observation, or null), and the warp (a
+  // pose warp, or the layered mesh; rendered unless deferred).
+  const FaceObservation* FaceStep(const cv::Mat& image, Time stamp,
+                                  const std::vector<Eigen::Vector2d>* external,
+                                  double external_confidence, cv::Mat* grey,
+                                  FaceObservation* observation, PipelineFrame* f);
+  Status WarpStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
+                  PipelineFrame* f);
   Pipeline(const CameraModel& model, const PipelineOptions& options);
   void ApplyOffsetEstimate(Time stamp);
 
