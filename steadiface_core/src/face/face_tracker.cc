@@ -435,9 +435,6 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
       ToSeconds(stamp - last_seen_) > options_.lost_timeout_s) {
     reset();
   }
-  Candidate c;
-  cv::Mat patch;
-  bool ok = false;
   // While searching, the full-frame detection runs once per
   // search_interval_s (1 ms of slack for frame-time jitter); a time jump
   // backwards searches at once.
@@ -447,92 +444,9 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
   if (state_ == TrackingState::kSearching && !search_due) {
     MarkFailure(FaceFailure::kNotSearched, stamp, info);
   } else if (state_ == TrackingState::kSearching) {
-    have_last_search_ = true;
-    last_search_ = stamp;
-    const auto t0 = Clock::now();
-    std::vector<FaceBox> faces;
-    detector_->Detect(gray, full, &faces);
-    info->timings.detect_ms += MsSince(t0);
-    info->detected = true;
-    for (const FaceBox& f : faces) {  // largest first
-      c = Candidate();
-      c.box = f.rect;
-      c.detected = true;
-      const auto t1 = Clock::now();
-      const bool fit = predictor_->Predict(gray, c.box, &c.landmarks).ok();
-      info->timings.landmarks_ms += MsSince(t1);
-      if (fit && Evaluate(&gray, c, true, nullptr, info, &patch)) {
-        ok = true;
-        break;
-      }
-    }
-    if (ok) {
-      Accept(c, true, patch, stamp, info);
-    } else {
-      MarkFailure(faces.empty() ? FaceFailure::kNoFace : info->failure, stamp, info);
-    }
+    Search(gray, full, stamp, info);
   } else {
-    std::vector<Eigen::Vector2d> predicted;
-    PredictLandmarks(stamp, timeline, timing, &predicted);
-    const Eigen::Vector2d pc = Mean(predicted);
-    const cv::Rect2d pbox = BoxFromLandmarks(predicted);
-    const cv::Rect2d inside = pbox & cv::Rect2d(0, 0, gray.cols, gray.rows);
-    const bool in_frame = inside.area() > 0.5 * pbox.area();
-    const double g = options_.redetect_region_scale;
-    const cv::Rect2d big(pbox.x - 0.5 * (g - 1) * pbox.width,
-                         pbox.y - 0.5 * (g - 1) * pbox.height, g * pbox.width,
-                         g * pbox.height);
-    const cv::Rect roi = cv::Rect(big) & full;
-    const bool want_detect = force_detect_ || state_ == TrackingState::kLost ||
-                             frames_since_detect_ + 1 >= options_.redetect_every_frames;
-    bool tried_detect = false;
-    if (want_detect && roi.area() > 0) {
-      tried_detect = true;
-      info->detected = true;
-      double det_ms = 0.0;
-      const auto t1 = Clock::now();
-      if (DetectAndFit(gray, roi, &pbox, &c, &det_ms)) {
-        ok = Evaluate(&gray, c, false, &pc, info, &patch);
-      }
-      info->timings.detect_ms += det_ms;
-      info->timings.landmarks_ms += MsSince(t1) - det_ms;
-    }
-    // The landmarks fitted where the gyro says the face is: while tracking,
-    // and while recently lost (the lost face is followed with the gyro), so
-    // a face that blur hides from the detector is kept or taken back as
-    // soon as its landmarks pass the checks against the locked face.
-    if (!ok && state_ != TrackingState::kSearching && in_frame) {
-      c = Candidate();
-      c.box = pbox;
-      const auto t1 = Clock::now();
-      const bool fit = predictor_->Predict(gray, c.box, &c.landmarks).ok();
-      info->timings.landmarks_ms += MsSince(t1);
-      ok = fit && Evaluate(&gray, c, false, &pc, info, &patch);
-      // Always re-detect after a failure.
-      if (!ok && !tried_detect && roi.area() > 0) {
-        const FaceFailure first = info->failure;
-        info->detected = true;
-        double det_ms = 0.0;
-        Candidate d;
-        if (DetectAndFit(gray, roi, &pbox, &d, &det_ms)) {
-          c = d;
-          ok = Evaluate(&gray, c, false, &pc, info, &patch);
-        }
-        info->timings.detect_ms += det_ms;
-        if (!ok) info->failure = first;
-      }
-    } else if (!ok && !in_frame && info->failure == FaceFailure::kNone) {
-      info->failure = FaceFailure::kOutOfFrame;
-    }
-    if (ok) {
-      Accept(c, false, patch, stamp, info);
-    } else {
-      MarkFailure(info->failure == FaceFailure::kNone ? FaceFailure::kNoFace : info->failure,
-                  stamp, info);
-      // Keep following the lost face with the gyro, so re-detection looks
-      // where it should be.
-      if (rot_ok) last_landmarks_ = predicted;
-    }
+    Track(gray, full, stamp, timeline, timing, rot_ok, info);
   }
   // Periodic re-detection counts from the last attempt, found or not.
   frames_since_detect_ = info->detected ? 0 : frames_since_detect_ + 1;
@@ -544,6 +458,109 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
   }
   info->timings.total_ms = MsSince(t_start);
   return Status::Ok();
+}
+
+void FaceTracker::Search(const cv::Mat& gray, const cv::Rect& full, Time stamp, FaceInfo* info) {
+  // A full-frame detection; the largest face whose landmarks pass the
+  // checks is locked.
+  Candidate c;
+  cv::Mat patch;
+  bool ok = false;
+  have_last_search_ = true;
+  last_search_ = stamp;
+  const auto t0 = Clock::now();
+  std::vector<FaceBox> faces;
+  detector_->Detect(gray, full, &faces);
+  info->timings.detect_ms += MsSince(t0);
+  info->detected = true;
+  for (const FaceBox& f : faces) {  // largest first
+    c = Candidate();
+    c.box = f.rect;
+    c.detected = true;
+    const auto t1 = Clock::now();
+    const bool fit = predictor_->Predict(gray, c.box, &c.landmarks).ok();
+    info->timings.landmarks_ms += MsSince(t1);
+    if (fit && Evaluate(&gray, c, true, nullptr, info, &patch)) {
+      ok = true;
+      break;
+    }
+  }
+  if (ok) {
+    Accept(c, true, patch, stamp, info);
+  } else {
+    MarkFailure(faces.empty() ? FaceFailure::kNoFace : info->failure, stamp, info);
+  }
+}
+
+void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
+                        const OrientationTimeline* timeline, const RowTiming* timing,
+                        bool rot_ok, FaceInfo* info) {
+  // The locked (or recently lost) face where the gyro predicts it:
+  // re-detection near it when due, else the landmarks fitted there.
+  Candidate c;
+  cv::Mat patch;
+  bool ok = false;
+  std::vector<Eigen::Vector2d> predicted;
+  PredictLandmarks(stamp, timeline, timing, &predicted);
+  const Eigen::Vector2d pc = Mean(predicted);
+  const cv::Rect2d pbox = BoxFromLandmarks(predicted);
+  const cv::Rect2d inside = pbox & cv::Rect2d(0, 0, gray.cols, gray.rows);
+  const bool in_frame = inside.area() > 0.5 * pbox.area();
+  const double g = options_.redetect_region_scale;
+  const cv::Rect2d big(pbox.x - 0.5 * (g - 1) * pbox.width,
+                       pbox.y - 0.5 * (g - 1) * pbox.height, g * pbox.width,
+                       g * pbox.height);
+  const cv::Rect roi = cv::Rect(big) & full;
+  const bool want_detect = force_detect_ || state_ == TrackingState::kLost ||
+                           frames_since_detect_ + 1 >= options_.redetect_every_frames;
+  bool tried_detect = false;
+  if (want_detect && roi.area() > 0) {
+    tried_detect = true;
+    info->detected = true;
+    double det_ms = 0.0;
+    const auto t1 = Clock::now();
+    if (DetectAndFit(gray, roi, &pbox, &c, &det_ms)) {
+      ok = Evaluate(&gray, c, false, &pc, info, &patch);
+    }
+    info->timings.detect_ms += det_ms;
+    info->timings.landmarks_ms += MsSince(t1) - det_ms;
+  }
+  // The landmarks fitted where the gyro says the face is: while tracking,
+  // and while recently lost (the lost face is followed with the gyro), so
+  // a face that blur hides from the detector is kept or taken back as
+  // soon as its landmarks pass the checks against the locked face.
+  if (!ok && state_ != TrackingState::kSearching && in_frame) {
+    c = Candidate();
+    c.box = pbox;
+    const auto t1 = Clock::now();
+    const bool fit = predictor_->Predict(gray, c.box, &c.landmarks).ok();
+    info->timings.landmarks_ms += MsSince(t1);
+    ok = fit && Evaluate(&gray, c, false, &pc, info, &patch);
+    // Always re-detect after a failure.
+    if (!ok && !tried_detect && roi.area() > 0) {
+      const FaceFailure first = info->failure;
+      info->detected = true;
+      double det_ms = 0.0;
+      Candidate d;
+      if (DetectAndFit(gray, roi, &pbox, &d, &det_ms)) {
+        c = d;
+        ok = Evaluate(&gray, c, false, &pc, info, &patch);
+      }
+      info->timings.detect_ms += det_ms;
+      if (!ok) info->failure = first;
+    }
+  } else if (!ok && !in_frame && info->failure == FaceFailure::kNone) {
+    info->failure = FaceFailure::kOutOfFrame;
+  }
+  if (ok) {
+    Accept(c, false, patch, stamp, info);
+  } else {
+    MarkFailure(info->failure == FaceFailure::kNone ? FaceFailure::kNoFace : info->failure,
+                stamp, info);
+    // Keep following the lost face with the gyro, so re-detection looks
+    // where it should be.
+    if (rot_ok) last_landmarks_ = predicted;
+  }
 }
 
 Status FaceTracker::ProcessExternal(const std::vector<Eigen::Vector2d>& lm,

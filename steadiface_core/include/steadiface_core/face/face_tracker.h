@@ -102,6 +102,13 @@ class FaceTracker {
  private:
   FaceTracker(const CameraModel& model, const FaceTrackerOptions& options);
 
+  // Process's two paths: a full-frame search while no face is locked, and
+  // tracking the locked (or recently lost) face where the gyro puts it.
+  void Search(const cv::Mat& gray, const cv::Rect& full, Time stamp, FaceInfo* info);
+  void Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
+             const OrientationTimeline* timeline, const RowTiming* timing, bool rot_ok,
+             FaceInfo* info);
+
   // Shared by both paths once landmarks exist for this frame.
   struct Candidate {
     std::vector<Eigen::Vector2d> landmarks;
