@@ -411,9 +411,24 @@ Score Scorecard::Compute() const {
   sc.head_jitter_px = HighPassRms(head, fps, options_.highpass_hz);
   sc.head_jitter_frac = sc.head_jitter_px / diag;
   sc.head_stability = Stability(head);
+  const size_t min_run = static_cast<size_t>(std::max(16.0, fps));  // >= 1 s
+  ComputeBackground(fps, min_run, diag, &sc);
+  ComputeMeshFigures(fps, &sc);
+  sc.cropping = pose ? std::pow(1.0 - 2.0 * output_.crop_ratio(), 2.0) : 1.0;
+  sc.distortion = *std::min_element(distortion_.begin(), distortion_.end());
+  sc.undefined_fraction = static_cast<double>(undefined_) / sc.frames;
+  for (const auto& st : stages_) {
+    sc.stage_ms.push_back({st.first, {Percentile(st.second, 0.5), Percentile(st.second, 0.99)}});
+  }
+  return sc;
+}
+
+void Scorecard::ComputeBackground(double fps, size_t min_run, double diag, Score* out) const {
+  // The far background's jitter and stability, the head relative to it,
+  // and the visible background's jitter.
+  Score& sc = *out;
   double bg = 0.0, bg_stab = 0.0;
   int nbg = 0;
-  const size_t min_run = static_cast<size_t>(std::max(16.0, fps));  // >= 1 s
   for (const auto& traj : background_out_) {
     const std::vector<Eigen::Vector2d> r = LongestFiniteRun(traj);
     if (r.size() < min_run) continue;
@@ -454,6 +469,11 @@ Score Scorecard::Compute() const {
     ++nvis;
   }
   sc.visible_background_jitter_px = nvis ? vis / nvis : NAN;
+}
+
+void Scorecard::ComputeMeshFigures(double fps, Score* out) const {
+  // Lines, cells, the band's jitter, and the largest per-frame steps.
+  Score& sc = *out;
   sc.line_deviation_px = line_dev_;
   sc.line_deviation_frame = line_dev_frame_;
   sc.min_cell_ratio = min_ratio_;
@@ -484,13 +504,6 @@ Score Scorecard::Compute() const {
     sc.head_target_max_step_px = step;
     sc.head_target_max_accel_px = accel;
   }
-  sc.cropping = pose ? std::pow(1.0 - 2.0 * output_.crop_ratio(), 2.0) : 1.0;
-  sc.distortion = *std::min_element(distortion_.begin(), distortion_.end());
-  sc.undefined_fraction = static_cast<double>(undefined_) / sc.frames;
-  for (const auto& st : stages_) {
-    sc.stage_ms.push_back({st.first, {Percentile(st.second, 0.5), Percentile(st.second, 0.99)}});
-  }
-  return sc;
 }
 
 }  // namespace eval

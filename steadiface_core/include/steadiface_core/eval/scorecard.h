@@ -163,6 +163,10 @@ class Scorecard {
   double CentreDistortion(const FrameWarp& w) const;
   bool Undefined(const FrameWarp& w, Sample* s) const;
   void AddStageTimes(const FrameWarp& w);
+  // Compute's pieces: the background figures (trajectories scored on runs
+  // of at least min_run frames) and the lines', cells' and steps' figures.
+  void ComputeBackground(double fps, size_t min_run, double diag, Score* sc) const;
+  void ComputeMeshFigures(double fps, Score* sc) const;
   bool MapToOutput(const FrameWarp& w, const Eigen::Vector2d& in_px,
                    Eigen::Vector2d* out_px) const;
 
