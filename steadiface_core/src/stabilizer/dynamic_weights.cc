@@ -49,31 +49,7 @@ WeightFactors DynamicWeights::Update(double dt_s, double mean_angular_speed,
       smooth_target = 1.0 + o.pose_smoothness_boost * s;
     }
     if (has_face) {
-      history_.emplace_back(stabilized_centre.x(), stabilized_centre.y(),
-                            stabilized_scale);
-      while (static_cast<int>(history_.size()) > o.variation_window) {
-        history_.pop_front();
-      }
-      if (history_.size() >= 3) {
-        double c2 = 0.0, s2 = 0.0;
-        int n = 0;
-        for (size_t i = 2; i < history_.size(); ++i) {
-          const Eigen::Vector3d d2 =
-              history_[i] - 2.0 * history_[i - 1] + history_[i - 2];
-          c2 += d2.head<2>().squaredNorm();
-          const double sc = std::max(history_[i - 1].z(), 1e-6);
-          s2 += (d2.z() / sc) * (d2.z() / sc);
-          ++n;
-        }
-        f.centre_variation = std::sqrt(c2 / n);
-        f.scale_variation = std::sqrt(s2 / n);
-        const double v = std::max(
-            SmoothStep(f.centre_variation, o.centre_variation_low,
-                       o.centre_variation_high),
-            SmoothStep(f.scale_variation, o.scale_variation_low,
-                       o.scale_variation_high));
-        f.variation_target = 1.0 - (1.0 - o.variation_min_fit_scale) * v;
-      }
+      f.variation_target = VariationTarget(stabilized_centre, stabilized_scale, &f);
     } else {
       history_.clear();
     }
@@ -109,6 +85,40 @@ WeightFactors DynamicWeights::Update(double dt_s, double mean_angular_speed,
   f.fit = presence_ * fit_gyro_ * fit_pose_ * fit_var_;
   f.smoothness = state_.smoothness;
   return f;
+}
+
+double DynamicWeights::VariationTarget(const Eigen::Vector2d& stabilized_centre,
+                                       double stabilized_scale, WeightFactors* out) {
+  // The landmark-variation factor: RMS second differences of the
+  // gyro-compensated centre and of the relative scale over the window.
+  const DynamicWeightOptions& o = options_;
+  WeightFactors& f = *out;
+  history_.emplace_back(stabilized_centre.x(), stabilized_centre.y(),
+                        stabilized_scale);
+  while (static_cast<int>(history_.size()) > o.variation_window) {
+    history_.pop_front();
+  }
+  if (history_.size() >= 3) {
+    double c2 = 0.0, s2 = 0.0;
+    int n = 0;
+    for (size_t i = 2; i < history_.size(); ++i) {
+      const Eigen::Vector3d d2 =
+          history_[i] - 2.0 * history_[i - 1] + history_[i - 2];
+      c2 += d2.head<2>().squaredNorm();
+      const double sc = std::max(history_[i - 1].z(), 1e-6);
+      s2 += (d2.z() / sc) * (d2.z() / sc);
+      ++n;
+    }
+    f.centre_variation = std::sqrt(c2 / n);
+    f.scale_variation = std::sqrt(s2 / n);
+    const double v = std::max(
+        SmoothStep(f.centre_variation, o.centre_variation_low,
+                   o.centre_variation_high),
+        SmoothStep(f.scale_variation, o.scale_variation_low,
+                   o.scale_variation_high));
+    return 1.0 - (1.0 - o.variation_min_fit_scale) * v;
+  }
+  return f.variation_target;
 }
 
 }  // namespace steadiface

@@ -57,6 +57,10 @@ class DynamicWeights {
   void set_options(const DynamicWeightOptions& options) { options_ = options; }
 
  private:
+  // The landmark-variation target (1 while fewer than 3 frames are in the
+  // window); the window's figures into *f.
+  double VariationTarget(const Eigen::Vector2d& stabilized_centre, double stabilized_scale,
+                         WeightFactors* f);
   DynamicWeightOptions options_;
   bool initialized_ = false;
   WeightFactors state_;
