@@ -286,23 +286,7 @@ bool FaceTracker::Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiri
   }
   // 4. Appearance: the aligned face patch against the locked face's.
   if (fail == FaceFailure::kNone && gray != nullptr) {
-    if (!AlignedPatch(*gray, c.landmarks, patch)) {
-      fail = FaceFailure::kImplausibleShape;
-    } else if (!acquiring && !reference_patch_.empty()) {
-      cv::Mat a = *patch - cv::mean(*patch)[0];
-      cv::Mat b = reference_patch_ - cv::mean(reference_patch_)[0];
-      const double na = cv::norm(a), nb = cv::norm(b);
-      info->appearance = na > 1e-6 && nb > 1e-6 ? a.dot(b) / (na * nb) : 0.0;
-      if (info->appearance < options_.min_appearance) {
-        fail = FaceFailure::kAppearance;
-      } else {
-        score_sum += (info->appearance - options_.min_appearance) /
-                     (1.0 - options_.min_appearance);
-        ++n_scores;
-      }
-    } else {
-      info->appearance = 1.0;
-    }
+    fail = CheckAppearance(*gray, c, acquiring, info, patch, &score_sum, &n_scores);
   }
   info->timings.checks_ms += MsSince(t0);
   info->failure = fail;
@@ -311,6 +295,32 @@ bool FaceTracker::Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiri
           ? std::min(1.0, std::max(0.0, 0.5 + 0.5 * (n_scores ? score_sum / n_scores : 1.0)))
           : 0.0;
   return fail == FaceFailure::kNone;
+}
+
+FaceFailure FaceTracker::CheckAppearance(const cv::Mat& gray, const Candidate& c, bool acquiring,
+                                         FaceInfo* info, cv::Mat* patch, double* score_sum,
+                                         int* n_scores) const {
+  // The normalized correlation of the aligned patch with the locked face's
+  // (not at acquisition); a passing check adds its score.
+  FaceFailure fail = FaceFailure::kNone;
+  if (!AlignedPatch(gray, c.landmarks, patch)) {
+    fail = FaceFailure::kImplausibleShape;
+  } else if (!acquiring && !reference_patch_.empty()) {
+    cv::Mat a = *patch - cv::mean(*patch)[0];
+    cv::Mat b = reference_patch_ - cv::mean(reference_patch_)[0];
+    const double na = cv::norm(a), nb = cv::norm(b);
+    info->appearance = na > 1e-6 && nb > 1e-6 ? a.dot(b) / (na * nb) : 0.0;
+    if (info->appearance < options_.min_appearance) {
+      fail = FaceFailure::kAppearance;
+    } else {
+      *score_sum +=
+          (info->appearance - options_.min_appearance) / (1.0 - options_.min_appearance);
+      ++*n_scores;
+    }
+  } else {
+    info->appearance = 1.0;
+  }
+  return fail;
 }
 
 void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,

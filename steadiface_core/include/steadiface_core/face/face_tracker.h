@@ -118,6 +118,10 @@ class FaceTracker {
   bool Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiring,
                 const Eigen::Vector2d* predicted_centre, FaceInfo* info,
                 cv::Mat* patch) const;
+  // Evaluate's appearance check.
+  FaceFailure CheckAppearance(const cv::Mat& gray, const Candidate& c, bool acquiring,
+                              FaceInfo* info, cv::Mat* patch, double* score_sum,
+                              int* n_scores) const;
   void Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,
               Time stamp, FaceInfo* info);
   void Fill(const std::vector<Eigen::Vector2d>& landmarks, FaceInfo* info) const;
