@@ -213,42 +213,57 @@ Status Simulator::Init() {
     }
     return P;
   };
-  {
-    // Neck and shoulders: a striped shirt, its top edge at the neck, 8 cm
-    // below the face's landmark centre; 2 mm per texel.
-    const double m = 0.002, width = o.torso_width_m, height = 0.5;
-    const int tw = static_cast<int>(width / m), th = static_cast<int>(height / m);
-    torso_.bgra = cv::Mat(th, tw, CV_8UC4);
-    for (int y = 0; y < th; ++y) {
-      cv::Vec4b* row = torso_.bgra.ptr<cv::Vec4b>(y);
-      for (int x = 0; x < tw; ++x) {
-        const double X = (x - 0.5 * (tw - 1)) * m, Y = y * m;
-        // Neck 12 cm wide, widening to the shoulders from 7 to 15 cm down.
-        const double s = std::min(1.0, std::max(0.0, (Y - 0.07) / 0.08));
-        const double half = 0.06 + (0.5 * width - 0.06) * s * s * (3 - 2 * s);
-        const double edge = (half - std::abs(X)) / m;  // texels inside
-        const double a = std::min(1.0, std::max(0.0, 0.5 + 0.5 * edge));
-        const bool neck = Y < 0.09;
-        const bool stripe = (x / 12) % 2 == 0;
-        row[x] = neck ? cv::Vec4b(120, 150, 200, 0) : stripe ? cv::Vec4b(150, 70, 40, 0)
-                                                            : cv::Vec4b(200, 190, 180, 0);
-        row[x][3] = static_cast<uchar>(std::lround(255.0 * a));
-      }
-    }
-    torso_.metres_per_px = m;
-    torso_.anchor_px = Eigen::Vector2d(0.5 * (tw - 1), 0.0);
-    torso_.pose = [this](double t) {
-      Pose P = face_.pose(t);
-      // The face billboard's position without its turning and nodding.
-      const Eigen::Vector3d centre = P.p + P.R * Eigen::Vector3d(
-          (face_centre_uv_.x() - face_.anchor_px.x()) * face_.metres_per_px,
-          (face_centre_uv_.y() - face_.anchor_px.y()) * face_.metres_per_px, 0.0);
-      Pose T;
-      T.R = Orbit(Pose(), t).R;
-      T.p = centre + T.R * Eigen::Vector3d(0.0, 0.08, options_.torso_depth_m);
-      return T;
-    };
+  MakeTorso();
+  MakeSecondFaceAndOccluder(photo, m_per_px);
+  if (o.use_real_gyro) {
+    const Status st = LoadRealGyro();
+    if (!st.ok()) return st;
   }
+  SynthesizeImu();
+  return Status::Ok();
+}
+
+void Simulator::MakeTorso() {
+  const SimulatorOptions& o = options_;
+  // Neck and shoulders: a striped shirt, its top edge at the neck, 8 cm
+  // below the face's landmark centre; 2 mm per texel.
+  const double m = 0.002, width = o.torso_width_m, height = 0.5;
+  const int tw = static_cast<int>(width / m), th = static_cast<int>(height / m);
+  torso_.bgra = cv::Mat(th, tw, CV_8UC4);
+  for (int y = 0; y < th; ++y) {
+    cv::Vec4b* row = torso_.bgra.ptr<cv::Vec4b>(y);
+    for (int x = 0; x < tw; ++x) {
+      const double X = (x - 0.5 * (tw - 1)) * m, Y = y * m;
+      // Neck 12 cm wide, widening to the shoulders from 7 to 15 cm down.
+      const double s = std::min(1.0, std::max(0.0, (Y - 0.07) / 0.08));
+      const double half = 0.06 + (0.5 * width - 0.06) * s * s * (3 - 2 * s);
+      const double edge = (half - std::abs(X)) / m;  // texels inside
+      const double a = std::min(1.0, std::max(0.0, 0.5 + 0.5 * edge));
+      const bool neck = Y < 0.09;
+      const bool stripe = (x / 12) % 2 == 0;
+      row[x] = neck ? cv::Vec4b(120, 150, 200, 0) : stripe ? cv::Vec4b(150, 70, 40, 0)
+                                                          : cv::Vec4b(200, 190, 180, 0);
+      row[x][3] = static_cast<uchar>(std::lround(255.0 * a));
+    }
+  }
+  torso_.metres_per_px = m;
+  torso_.anchor_px = Eigen::Vector2d(0.5 * (tw - 1), 0.0);
+  torso_.pose = [this](double t) {
+    Pose P = face_.pose(t);
+    // The face billboard's position without its turning and nodding.
+    const Eigen::Vector3d centre = P.p + P.R * Eigen::Vector3d(
+        (face_centre_uv_.x() - face_.anchor_px.x()) * face_.metres_per_px,
+        (face_centre_uv_.y() - face_.anchor_px.y()) * face_.metres_per_px, 0.0);
+    Pose T;
+    T.R = Orbit(Pose(), t).R;
+    T.p = centre + T.R * Eigen::Vector3d(0.0, 0.08, options_.torso_depth_m);
+    return T;
+  };
+}
+
+void Simulator::MakeSecondFaceAndOccluder(const cv::Mat& photo, double m_per_px) {
+  // The second face (the mirrored photo, approaching) and the occluding hand.
+  const SimulatorOptions& o = options_;
   cv::Mat mirrored;
   cv::flip(photo, mirrored, 1);
   cv::Rect mr = o.face_region;
@@ -274,22 +289,31 @@ Status Simulator::Init() {
     P.p.x() += -0.25 + 0.5 * s;
     return P;
   };
-  if (o.use_real_gyro) {
-    std::vector<GyroSample> raw;
-    Status st = LoadDeepFvsGyro(o.data_dir + "/gyro/gyro_log_144425_189635.txt", &raw);
-    if (!st.ok()) return st;
-    OrientationTimelineOptions to;
-    to.buffer_duration_s = 600.0;
-    to.max_samples = 10000000;
-    to.max_extrapolation_s = 0.0;
-    real_gyro_.reset(new OrientationTimeline(to));
-    for (auto& g : raw) {
-      g.angular_velocity *= o.real_gyro_scale;
-      real_gyro_->AddSample(g);
-    }
-    real_gyro_span_s_ = ToSeconds(real_gyro_->newest()) - 0.01;
+}
+
+Status Simulator::LoadRealGyro() {
+  // The recorded trace, scaled, replayed as the camera's rotation.
+  const SimulatorOptions& o = options_;
+  std::vector<GyroSample> raw;
+  Status st = LoadDeepFvsGyro(o.data_dir + "/gyro/gyro_log_144425_189635.txt", &raw);
+  if (!st.ok()) return st;
+  OrientationTimelineOptions to;
+  to.buffer_duration_s = 600.0;
+  to.max_samples = 10000000;
+  to.max_extrapolation_s = 0.0;
+  real_gyro_.reset(new OrientationTimeline(to));
+  for (auto& g : raw) {
+    g.angular_velocity *= o.real_gyro_scale;
+    real_gyro_->AddSample(g);
   }
-  // IMU.
+  real_gyro_span_s_ = ToSeconds(real_gyro_->newest()) - 0.01;
+  return Status::Ok();
+}
+
+void Simulator::SynthesizeImu() {
+  // The gyro samples: the true rate plus bias, noise, stamp jitter and the
+  // IMU clock's offset.
+  const SimulatorOptions& o = options_;
   std::mt19937_64 rng(options_.seed * 104729 + 3);
   std::normal_distribution<double> n01(0.0, 1.0);
   const double t_end = o.duration_s + o.readout_s + 0.06;
@@ -311,7 +335,6 @@ Status Simulator::Init() {
     const double stamp = t + std::max(-clamp, std::min(clamp, jitter)) - o.imu_clock_offset_s;
     imu_.push_back({Time(FromSeconds(stamp)), w});
   }
-  return Status::Ok();
 }
 
 Eigen::Vector3d Simulator::Body(double t) const {

@@ -157,6 +157,12 @@ class Simulator {
  private:
   explicit Simulator(const SimulatorOptions& options);
   Status Init();
+  // Init's pieces: the torso billboard; the second face and the occluder;
+  // the recorded gyro trace (use_real_gyro); the IMU samples.
+  void MakeTorso();
+  void MakeSecondFaceAndOccluder(const cv::Mat& photo, double m_per_px);
+  Status LoadRealGyro();
+  void SynthesizeImu();
   Eigen::Vector3d Body(double t) const;
   /// Applies the pan orbit (if any) to a world pose.
   Pose Orbit(const Pose& P, double t) const;
