@@ -167,6 +167,22 @@ class StabilizerWrapper {
   void Publish(const Pending& p, const steadiface::PipelineFrame& frame,
                const cv::Mat& input, bool extrapolated, bool passthrough,
                const ros::Time& started);
+  // Publish's pieces: the stabilized image and camera_info; landmarks and
+  // state (with latencies); TF (strictly increasing stamps); rviz frusta and
+  // the head target; the debug image; the status the diagnostics report.
+  void PublishOutputImage(const steadiface::PipelineFrame& frame,
+                          const std_msgs::Header& out_header);
+  void PublishLandmarksAndState(const Pending& p, const steadiface::PipelineFrame& frame,
+                                const std_msgs::Header& lm_header, bool extrapolated,
+                                const ros::Time& started, const ros::Time& published);
+  void PublishTransforms(const steadiface::PipelineFrame& frame,
+                         const std_msgs::Header& in_header, const std::string& camera_frame,
+                         const std_msgs::Header& out_header);
+  void PublishRvizExtras(const steadiface::PipelineFrame& frame,
+                         const std_msgs::Header& in_header, const std_msgs::Header& out_header);
+  void PublishDebugImage(const steadiface::PipelineFrame& frame, const cv::Mat& input,
+                         const std_msgs::Header& in_header);
+  void UpdateStatus(const steadiface::PipelineFrame& frame, const std_msgs::Header& in_header);
   // pipelined: waits for the held frame's rendering and publishes it.
   void FinishHeld();
 
