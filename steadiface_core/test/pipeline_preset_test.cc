@@ -1,0 +1,204 @@
+// The full pipeline on rendered presets against gyro-only and the input:
+// head and background jitter, the crop, a face leaving and coming back, a
+// brightness change, no undefined pixels.
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "steadiface_core/eval/run_methods.h"
+#include "steadiface_core/eval/scorecard.h"
+#include "steadiface_core/pipeline.h"
+#include "steadiface_core/sim/simulator.h"
+#include "steadiface_core/so3.h"
+#include "sim_util.h"
+#include "test_util.h"
+
+namespace steadiface {
+namespace {
+
+std::unique_ptr<sim::Simulator> Make(const std::string& preset,
+                                     std::function<void(sim::SimulatorOptions*)> tweak = {}) {
+  return testing_util::MakeSimulator(preset, tweak);
+}
+
+struct PresetResult {
+  eval::Score none, gyro, full;
+};
+
+// `crop_ratio` < 0: the package default; `duration_s` < 0: the simulator's.
+PresetResult Score(const std::string& preset, double crop_ratio = -1.0,
+                   double duration_s = -1.0) {
+  auto s = Make(preset, [duration_s](sim::SimulatorOptions* o) {
+    if (duration_s > 0.0) o->duration_s = duration_s;
+  });
+  PresetResult r;
+  for (eval::Method method : {eval::Method::kNone, eval::Method::kGyroOnly, eval::Method::kSteadiface}) {
+    PipelineOptions po = eval::OptionsFor(*s, method);
+    if (crop_ratio >= 0.0) po.warp.output.crop_ratio = crop_ratio;
+    std::unique_ptr<eval::Scorecard> card;
+    Status st = eval::MakeScorecard(*s, po, &card);
+    if (st.ok()) st = eval::RunMethod(*s, method, po, false, card.get(), nullptr);
+    EXPECT_TRUE(st.ok()) << st.message();
+    if (!st.ok()) continue;
+    (method == eval::Method::kNone ? r.none : method == eval::Method::kGyroOnly ? r.gyro : r.full) =
+        card->Compute();
+  }
+  std::cout << "[ " << preset << " ] head jitter none " << r.none.head_jitter_px << " / gyro-only "
+            << r.gyro.head_jitter_px << " / steadiface " << r.full.head_jitter_px
+            << " px; background " << r.none.background_jitter_px << " / "
+            << r.gyro.background_jitter_px << " / " << r.full.background_jitter_px
+            << " px; head-vs-background " << r.none.relative_jitter_px << " / "
+            << r.gyro.relative_jitter_px << " / " << r.full.relative_jitter_px
+            << " px; background floor " << r.full.background_floor_px
+            << " px; undefined " << r.gyro.undefined_fraction << " / "
+            << r.full.undefined_fraction << "\n";
+  return r;
+}
+
+TEST(PipelinePresetTest, WalkBeatsGyroOnlyOnTheHeadAndKeepsTheBackground) {
+  const PresetResult r = Score("walk");
+  EXPECT_LE(r.full.head_jitter_px, 0.5 * r.gyro.head_jitter_px);
+  EXPECT_LE(r.full.head_jitter_px, 0.3 * r.none.head_jitter_px);
+  EXPECT_LE(r.gyro.background_jitter_px, 0.2 * r.none.background_jitter_px);
+  EXPECT_LE(r.full.background_jitter_px, 0.85 * r.none.background_jitter_px);
+  EXPECT_EQ(r.full.undefined_fraction, 0.0);
+}
+
+// One rotation and offset per frame moves the head and the far background
+// alike, so the head's jitter relative to the background is fixed by the
+// scene (up to the zoom and the rolling-shutter correction), and holding the
+// head costs the background at least that much. Steadiface pays little more
+// than that floor. On pan the person turns with the phone: the head moves
+// more against the background than the camera shakes, so no such warp can
+// hold the head to 0.3x the input's jitter and keep the background below the
+// input's.
+TEST(PipelinePresetTest, HoldingTheHeadCostsTheBackgroundLittleMoreThanGeometryRequires) {
+  const double zoom = 1.0 / (1.0 - 2.0 * OutputOptions().crop_ratio);
+  for (const std::string preset : {"walk", "pan"}) {
+    SCOPED_TRACE(preset);
+    const PresetResult r = Score(preset);
+    const double conserved = zoom * r.none.relative_jitter_px;
+    EXPECT_NEAR(r.gyro.relative_jitter_px, conserved, 0.12 * conserved);
+    EXPECT_NEAR(r.full.relative_jitter_px, conserved, 0.12 * conserved);
+    EXPECT_LE(r.full.background_jitter_px, 1.25 * r.full.background_floor_px);
+    if (preset == "pan") {
+      EXPECT_GT(conserved - 0.3 * r.none.head_jitter_px, r.none.background_jitter_px);
+    }
+  }
+}
+
+TEST(PipelinePresetTest, RunWithTheRealGyroTrace) {
+  // The whole recorded running trace (9.9 s) at the default (the paper's)
+  // 15 % crop: the issue's bars hold (measured: steadiface's head jitter
+  // 0.17x the input's and 0.31x gyro-only's; gyro-only removes 59 % of the
+  // background jitter, steadiface 59 %).
+  const PresetResult r = Score("run", -1.0, 9.8);
+  EXPECT_LE(r.full.head_jitter_px, 0.3 * r.none.head_jitter_px);
+  EXPECT_LE(r.full.head_jitter_px, 0.5 * r.gyro.head_jitter_px);
+  EXPECT_LE(r.gyro.background_jitter_px, 0.5 * r.none.background_jitter_px);
+  EXPECT_LE(r.full.background_jitter_px, 0.5 * r.none.background_jitter_px);
+  EXPECT_EQ(r.full.undefined_fraction, 0.0);
+  EXPECT_EQ(r.gyro.undefined_fraction, 0.0);
+}
+
+TEST(PipelinePresetTest, ALargerCropRemovesMoreOfTheRunningShake) {
+  // The crop margin bounds what any warp can remove; on the running trace's
+  // first 3 s (one 0.12 rad tilt larger than a 10 % margin) the head jitter
+  // falls as the crop grows (measured 12.4 / 8.0 / 4.4 px at 10 / 15 / 20 %,
+  // input 24.7 px).
+  double previous = 1e9;
+  for (double crop : {0.1, 0.15, 0.2}) {
+    SCOPED_TRACE(crop);
+    const PresetResult r = Score("run", crop);
+    EXPECT_LT(r.full.head_jitter_px, 0.8 * previous);
+    EXPECT_LE(r.full.head_jitter_px, 0.55 * r.none.head_jitter_px);
+    EXPECT_EQ(r.full.undefined_fraction, 0.0);
+    previous = r.full.head_jitter_px;
+  }
+}
+
+// The face leaves the frame sideways and comes back (issue: simulator,
+// events; issue: stabilizer, no face): the truth flags the frames, the
+// stabilizer fades to gyro-only while the face is out and back in after it
+// returns, with bounded per-frame weight steps and no undefined pixels.
+TEST(PipelinePresetTest, FaceLeavingAndReenteringFadesWithoutJumps) {
+  auto s = Make("walk", [](sim::SimulatorOptions* o) {
+    o->duration_s = 4.0;
+    o->face_out_start_s = 1.2;
+    o->face_out_end_s = 2.4;
+  });
+  int out_frames = 0;
+  for (int i = 0; i < s->num_frames(); ++i) out_frames += s->Truth(i).face_out ? 1 : 0;
+  EXPECT_FALSE(s->Truth(0).face_out);
+  EXPECT_FALSE(s->Truth(s->num_frames() - 1).face_out);
+  EXPECT_GT(out_frames, 20);
+  const PipelineOptions po = eval::OptionsFor(*s, eval::Method::kSteadiface);
+  std::unique_ptr<eval::Scorecard> card;
+  ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
+  std::vector<StabilizerFrame> frames;
+  ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadiface, po, false, card.get(), &frames).ok());
+  ASSERT_EQ(static_cast<int>(frames.size()), s->num_frames());
+  double max_step = 0.0, min_fit_out = 1.0, max_fit_back = 0.0;
+  int used_while_out = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const double t = ToSeconds(frames[i].stamp - frames[0].stamp);
+    if (i > 0) max_step = std::max(max_step, std::abs(frames[i].factors.fit - frames[i - 1].factors.fit));
+    // Fully out of view (the 0.4 s ramp done) and 0.5 s later: faded out.
+    if (t > 1.6 + 0.5 && t < 2.4) min_fit_out = std::min(min_fit_out, frames[i].factors.fit);
+    if (t > 1.6 + 0.5 && t < 2.4 && frames[i].flags.face_used) ++used_while_out;
+    if (t > 3.3) max_fit_back = std::max(max_fit_back, frames[i].factors.fit);
+  }
+  std::cout << "[ face leaves ] " << out_frames << " frames out of view; w_f factor while out "
+            << min_fit_out << ", after return " << max_fit_back << ", max step " << max_step
+            << "\n";
+  EXPECT_LT(min_fit_out, 0.15);     // gyro-only while the face is away
+  EXPECT_GT(max_fit_back, 0.5);     // the face is back and used again
+  EXPECT_EQ(used_while_out, 0);
+  EXPECT_LT(max_step, 0.2);         // fades, never jumps
+  EXPECT_EQ(card->Compute().undefined_fraction, 0.0);
+}
+
+// A global brightness change mid-sequence (auto exposure): the face stays
+// tracked through it, and the head stays steadier than gyro-only.
+TEST(PipelinePresetTest, BrightnessChangeKeepsTheFace) {
+  auto s = Make("walk", [](sim::SimulatorOptions* o) { o->brightness_change_s = 1.5; });
+  int changed = 0;
+  for (int i = 0; i < s->num_frames(); ++i) changed += s->Truth(i).brightness_changed ? 1 : 0;
+  EXPECT_GT(changed, 10);
+  eval::Score full, gyro;
+  for (eval::Method method : {eval::Method::kGyroOnly, eval::Method::kSteadiface}) {
+    const PipelineOptions po = eval::OptionsFor(*s, method);
+    std::unique_ptr<eval::Scorecard> card;
+    ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
+    std::vector<StabilizerFrame> frames;
+    ASSERT_TRUE(eval::RunMethod(*s, method, po, false, card.get(), &frames).ok());
+    (method == eval::Method::kSteadiface ? full : gyro) = card->Compute();
+    if (method == eval::Method::kSteadiface) {
+      int used_after = 0, after = 0;
+      for (size_t i = 0; i < frames.size(); ++i) {
+        if (ToSeconds(frames[i].stamp - frames[0].stamp) > 1.6) {
+          ++after;
+          used_after += frames[i].flags.face_used ? 1 : 0;
+        }
+      }
+      EXPECT_GT(used_after, 0.9 * after) << "face lost after the brightness change";
+    }
+  }
+  EXPECT_LT(full.head_jitter_px, 0.5 * gyro.head_jitter_px);
+}
+
+TEST(PipelinePresetTest, EveryPresetHasNoUndefinedPixels) {
+  for (const std::string& p : {"still", "pan", "occlusion", "two_faces", "turn_away"}) {
+    const PresetResult r = Score(p);
+    EXPECT_EQ(r.full.undefined_fraction, 0.0) << p;
+    EXPECT_EQ(r.gyro.undefined_fraction, 0.0) << p;
+    EXPECT_GT(r.full.distortion, 0.9) << p;
+  }
+}
+
+}  // namespace
+}  // namespace steadiface
