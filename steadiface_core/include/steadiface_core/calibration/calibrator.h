@@ -16,6 +16,8 @@
 
 namespace steadiface {
 
+class GyroIntegral;
+
 /// Options of the offline camera-IMU calibration (issue 16).
 struct CalibratorOptions {
   /// Width of the grey copy features are tracked on [px].
@@ -130,6 +132,16 @@ class Calibrator {
     std::vector<Eigen::Vector2d> px_b;   // undistorted pixels
     std::vector<double> row_a, row_b;    // raw rows
   };
+
+  // Solve's checks: enough video and IMU data; the gyro covers the video
+  // [s since the gyro origin], enough pairs have enough tracks (into *good,
+  // *tracks), the camera turned enough (res->mean_angular_speed); then,
+  // after the solve, that the clock offset and the rotation are determined.
+  Status CheckLength(double duration_s) const;
+  Status CheckRecording(const GyroIntegral& g, double video_begin, double video_end,
+                        std::vector<const Pair*>* good, size_t* tracks,
+                        CalibrationResult* res) const;
+  Status Determined(const CalibrationResult& res, bool have_cov) const;
 
   const CameraIntrinsics k_;
   const RollingShutterOptions shutter_;
