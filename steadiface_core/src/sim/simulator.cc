@@ -35,24 +35,29 @@ const std::vector<std::string>& PresetNames() {
   return names;
 }
 
-Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
-  // Shared walking-selfie base.
-  auto walk = [o]() {
-    o->camera.shake_rms_rad = 0.012;
-    o->camera.translation_rms_m = 0.002;
-    o->camera.pan_rate = 0.0;
-    o->body_bob_m = 0.02;
-    o->body_sway_m = 0.01;
-  };
-  // Handheld by someone standing: a small tremor (0.15 deg RMS per axis),
-  // the subject with neck and shoulders.
-  auto standing_tremor = [o]() {
-    o->camera.shake_rms_rad = 0.15 * M_PI / 180.0;
-    o->camera.translation_rms_m = 0.001;
-    o->camera.pan_rate = 0.0;
-    o->body_bob_m = o->body_sway_m = 0.0;
-    o->render_torso = true;
-  };
+namespace {
+
+// The walking-selfie base.
+void Walking(SimulatorOptions* o) {
+  o->camera.shake_rms_rad = 0.012;
+  o->camera.translation_rms_m = 0.002;
+  o->camera.pan_rate = 0.0;
+  o->body_bob_m = 0.02;
+  o->body_sway_m = 0.01;
+}
+
+// Handheld by someone standing: a small tremor (0.15 deg RMS per axis), the
+// subject with neck and shoulders.
+void StandingTremor(SimulatorOptions* o) {
+  o->camera.shake_rms_rad = 0.15 * M_PI / 180.0;
+  o->camera.translation_rms_m = 0.001;
+  o->camera.pan_rate = 0.0;
+  o->body_bob_m = o->body_sway_m = 0.0;
+  o->render_torso = true;
+}
+
+// The presets that differ by the camera's motion; false for another name.
+bool ApplyCameraPreset(const std::string& name, SimulatorOptions* o) {
   if (name == "still") {
     o->camera.shake_rms_rad = 0.0;
     o->camera.translation_rms_m = 0.0;
@@ -60,14 +65,14 @@ Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
     o->head.bob_amplitude_m = 0.01;
     o->head.sway_amplitude_m = 0.012;
   } else if (name == "walk") {
-    walk();
+    Walking(o);
   } else if (name == "pan") {
     o->camera.shake_rms_rad = 0.004;
     o->camera.translation_rms_m = 0.001;
     o->camera.pan_rate = 0.2;
     o->body_bob_m = o->body_sway_m = 0.0;
   } else if (name == "run") {
-    walk();
+    Walking(o);
     o->use_real_gyro = true;
     o->body_bob_m = 0.04;
     o->body_bob_hz = 2.6;
@@ -75,7 +80,7 @@ Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
   } else if (name == "shake") {
     // Strong real shake: the recorded running trace scaled up, a grey
     // picture, motion blur and a slow rolling shutter.
-    walk();
+    Walking(o);
     o->use_real_gyro = true;
     o->real_gyro_scale = 3.0;
     o->body_bob_m = 0.04;
@@ -84,26 +89,34 @@ Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
     o->grayscale = true;
     o->exposure_s = 0.025;
     o->readout_s = 0.03;
-  } else if (name == "occlusion") {
-    walk();
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// The presets that differ by the subject; false for another name.
+bool ApplySubjectPreset(const std::string& name, SimulatorOptions* o) {
+  if (name == "occlusion") {
+    Walking(o);
     o->occlusion_start_s = 0.35 * o->duration_s;
     o->occlusion_end_s = 0.6 * o->duration_s;
   } else if (name == "two_faces") {
-    walk();
+    Walking(o);
     o->second_face_start_s = 0.25 * o->duration_s;
     o->second_face_final_distance_m = 0.4;
   } else if (name == "vlog") {
-    walk();
+    Walking(o);
     o->render_torso = true;
     o->head.distance_m = 0.7;
   } else if (name == "turn_away") {
-    walk();
+    Walking(o);
     o->head.yaw_amplitude_rad = 1.2;
     o->head.yaw_hz = 0.5 / std::max(1.0, o->duration_s);
   } else if (name == "drift") {
     // The head drifts several cm against the scene and turns (yaw 12 deg
     // RMS).
-    standing_tremor();
+    StandingTremor(o);
     o->head.distance_m = 0.6;
     o->head.drift_amplitude_m = 0.05;
     o->head.drift_hz = 0.2;
@@ -112,17 +125,24 @@ Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
   } else if (name == "walk_across") {
     // The subject walks across the view, 0.9 m away, from 0.35 m left of
     // the centre to 0.35 m right of it over the sequence.
-    standing_tremor();
+    StandingTremor(o);
     o->head.distance_m = 0.9;
     o->head.bob_amplitude_m = 0.02;
     o->head.walk_start_x_m = -0.35;
     o->head.walk_speed_m_s = 0.7 / std::max(0.1, o->duration_s);
   } else {
-    std::string all;
-    for (const auto& n : PresetNames()) all += " " + n;
-    return Status::Error("unknown preset '" + name + "'; presets:" + all);
+    return false;
   }
-  return Status::Ok();
+  return true;
+}
+
+}  // namespace
+
+Status ApplyPreset(const std::string& name, SimulatorOptions* o) {
+  if (ApplyCameraPreset(name, o) || ApplySubjectPreset(name, o)) return Status::Ok();
+  std::string all;
+  for (const auto& n : PresetNames()) all += " " + n;
+  return Status::Error("unknown preset '" + name + "'; presets:" + all);
 }
 
 Status LoadDeepFvsGyro(const std::string& path, std::vector<GyroSample>* out) {
