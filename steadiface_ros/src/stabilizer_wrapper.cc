@@ -289,47 +289,17 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   // renders from its own mesh copy, so it is not affected.
   ApplyPendingOptions();
   cv::Mat image;
-  steadiface::Status s = ToCvImage(*p.image, &image);
-  if (!s.ok()) {
-    ++counters_.dropped_bad_image;
-    sink_->Error("image", s.message());
-    status_.last_error = s.message();
-    return;
-  }
-  const steadiface::CameraIntrinsics& k = pipeline_->camera_model().intrinsics();
-  if (image.cols != k.width || image.rows != k.height) {
-    ++counters_.dropped_bad_image;
-    const std::string m = "image is " + std::to_string(image.cols) + "x" +
-                          std::to_string(image.rows) + " but camera_info says " +
-                          std::to_string(k.width) + "x" + std::to_string(k.height);
-    sink_->Error("image_size", m);
-    status_.last_error = m;
-    return;
-  }
+  if (!ToCheckedImage(p, &image)) return;
   const steadiface::Time stamp = ToCoreTime(p.image->header.stamp);
   const bool imu_dead =
       !have_last_imu_ ||
       (p.image->header.stamp - last_imu_stamp_).toSec() > wrapper_options_.imu_timeout_s;
-  steadiface::PipelineFrame frame;
-  bool extrapolated = false;
   if (imu_dead) {
-    if (!wrapper_options_.passthrough_without_imu) {
-      ++counters_.dropped_no_gyro;
-      sink_->Error("no_imu", "no IMU data: frame dropped (passthrough_without_imu: false)");
-      return;
-    }
-    s = pipeline_->Passthrough(image, &frame);
-    if (!s.ok()) {
-      ++counters_.dropped_pipeline_error;
-      return;
-    }
-    ++counters_.passthrough;
-    sink_->Error("no_imu", "no IMU data: publishing unstabilized frames");
-    last_frame_stamp_ = p.image->header.stamp;
-    FinishHeld();  // in order
-    Publish(p, frame, image, false, true, started);
+    PublishPassthrough(p, image, started);
     return;
   }
+  steadiface::PipelineFrame frame;
+  bool extrapolated = false;
   if (late) {
     if (wrapper_options_.late_frame_policy == LateFramePolicy::kDrop) {
       ++counters_.dropped_no_gyro;
@@ -346,7 +316,8 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
       use_external && last_external_stamp_ == p.image->header.stamp ? &external_landmarks_ : &none;
   const bool pipelined = wrapper_options_.pipelined;
   // Pipelined, this runs while the previous frame renders on render_.
-  s = pipelined ? pipeline_->ProcessFrameDeferred(image, stamp, ext, external_confidence_, &frame)
+  const steadiface::Status s =
+      pipelined ? pipeline_->ProcessFrameDeferred(image, stamp, ext, external_confidence_, &frame)
                 : pipeline_->ProcessFrame(image, stamp, ext, external_confidence_, &frame);
   if (!s.ok()) {
     ++(late ? counters_.dropped_no_gyro : counters_.dropped_pipeline_error);
@@ -368,6 +339,50 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   held_.reset(new Held{p, std::move(frame), image, extrapolated, started});
   Held* h = held_.get();
   render_.Start([h] { steadiface::Pipeline::RenderDeferred(h->image, &h->frame); });
+}
+
+bool StabilizerWrapper::ToCheckedImage(const Pending& p, cv::Mat* image) {
+  // The image as OpenCV sees it, of the camera's size; else counted,
+  // reported and false.
+  steadiface::Status s = ToCvImage(*p.image, image);
+  if (!s.ok()) {
+    ++counters_.dropped_bad_image;
+    sink_->Error("image", s.message());
+    status_.last_error = s.message();
+    return false;
+  }
+  const steadiface::CameraIntrinsics& k = pipeline_->camera_model().intrinsics();
+  if (image->cols != k.width || image->rows != k.height) {
+    ++counters_.dropped_bad_image;
+    const std::string m = "image is " + std::to_string(image->cols) + "x" +
+                          std::to_string(image->rows) + " but camera_info says " +
+                          std::to_string(k.width) + "x" + std::to_string(k.height);
+    sink_->Error("image_size", m);
+    status_.last_error = m;
+    return false;
+  }
+  return true;
+}
+
+void StabilizerWrapper::PublishPassthrough(const Pending& p, const cv::Mat& image,
+                                           const ros::Time& started) {
+  // Without IMU data: the unstabilized frame, or nothing.
+  if (!wrapper_options_.passthrough_without_imu) {
+    ++counters_.dropped_no_gyro;
+    sink_->Error("no_imu", "no IMU data: frame dropped (passthrough_without_imu: false)");
+    return;
+  }
+  steadiface::PipelineFrame frame;
+  const steadiface::Status s = pipeline_->Passthrough(image, &frame);
+  if (!s.ok()) {
+    ++counters_.dropped_pipeline_error;
+    return;
+  }
+  ++counters_.passthrough;
+  sink_->Error("no_imu", "no IMU data: publishing unstabilized frames");
+  last_frame_stamp_ = p.image->header.stamp;
+  FinishHeld();  // in order
+  Publish(p, frame, image, false, true, started);
 }
 
 void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFrame& frame,

@@ -167,6 +167,11 @@ class StabilizerWrapper {
   void Publish(const Pending& p, const steadiface::PipelineFrame& frame,
                const cv::Mat& input, bool extrapolated, bool passthrough,
                const ros::Time& started);
+  // Process's pieces: the message as an image of the camera's size (else
+  // counted, reported and false), and a frame without IMU data
+  // (passthrough_without_imu).
+  bool ToCheckedImage(const Pending& p, cv::Mat* image);
+  void PublishPassthrough(const Pending& p, const cv::Mat& image, const ros::Time& started);
   // Publish's pieces: the stabilized image and camera_info; landmarks and
   // state (with latencies); TF (strictly increasing stamps); rviz frusta and
   // the head target; the debug image; the status the diagnostics report.
