@@ -353,17 +353,14 @@ steadiface::Status FromMsg(const steadiface::FaceLandmarks& m, std::vector<Eigen
   return steadiface::Status::Ok();
 }
 
-steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std_msgs::Header& header,
-                                  bool gyro_extrapolated) {
-  const steadiface::StabilizerFrame& f = pf.stabilizer;
-  steadiface::StabilizerState m;
-  m.header = header;
-  m.has_target = f.has_target;
-  m.target_h = {f.H.x(), f.H.y()};
-  m.centre_c = {f.C.x(), f.C.y()};
-  m.virtual_rotation = ToMsg(f.R_v);
-  m.real_rotation = ToMsg(f.R_r);
-  m.principal_offset = {f.t.x(), f.t.y()};
+namespace {
+
+// StabilizerState from a PipelineFrame, in parts: the terms' energies and
+// weights, the weight factors and the solver; the face checks and the
+// stabilizer's flags; both layers and the blend; the gyro-vs-video check;
+// and nothing non-finite leaving the node.
+void FillTermsAndSolver(const steadiface::StabilizerFrame& f, steadiface::StabilizerState* out) {
+  steadiface::StabilizerState& m = *out;
   m.energy_fit = f.energies.fit;
   m.energy_distortion = f.energies.distortion;
   m.energy_follow = f.energies.follow;
@@ -385,6 +382,11 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   m.solver_termination = f.solver.termination;
   m.solver_time_ms = f.solver.time_ms;
   m.solver_usable = f.solver.usable;
+}
+
+void FillFaceAndFlags(const steadiface::PipelineFrame& pf, steadiface::StabilizerState* out) {
+  const steadiface::StabilizerFrame& f = pf.stabilizer;
+  steadiface::StabilizerState& m = *out;
   m.face_state = static_cast<uint8_t>(pf.face.state);
   m.face_failure = steadiface::FaceFailureName(pf.face.failure);
   m.face_detected = pf.face.detected;
@@ -399,7 +401,11 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   m.protrusion_search_s = f.flags.protrusion_search_s;
   m.previous_warp = f.flags.previous_warp;
   m.undefined_pixels = f.flags.undefined_pixels;
-  m.gyro_extrapolated = gyro_extrapolated;
+}
+
+void FillLayers(const steadiface::PipelineFrame& pf, steadiface::StabilizerState* out) {
+  const steadiface::StabilizerFrame& f = pf.stabilizer;
+  steadiface::StabilizerState& m = *out;
   m.has_background_layer = f.background.valid;
   m.background_rotation = ToMsg(f.background.R_v);
   m.background_principal_offset = {f.background.t.x(), f.background.t.y()};
@@ -419,6 +425,10 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
     m.layer_keep = 1.0;
     m.min_cell_ratio = 1.0;
   }
+}
+
+void FillGyroVideoCheck(const steadiface::PipelineFrame& pf, steadiface::StabilizerState* out) {
+  steadiface::StabilizerState& m = *out;
   const steadiface::GyroVideoCheckResult& c = pf.gyro_video_check;
   m.check_judged = c.judged;
   m.check_motion_px = c.motion_px;
@@ -429,10 +439,10 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
   m.imu_offset_correction_s = c.offset_correction_s;
   m.imu_offset_off = c.offset_off;
   m.imu_offset_applied_s = pf.imu_offset_applied_s;
-  m.face_ms = pf.timings.face_ms;
-  m.stabilizer_ms = pf.timings.stabilizer_ms;
-  m.warp_ms = pf.timings.mesh_ms + pf.timings.maps_ms + pf.timings.remap_ms;
-  m.total_ms = pf.timings.total_ms;
+}
+
+void ZeroNonFinite(steadiface::StabilizerState* out) {
+  steadiface::StabilizerState& m = *out;
   // Nothing non-finite leaves the node.
   auto clean = [](double& v) {
     if (!std::isfinite(v)) v = 0.0;
@@ -446,6 +456,31 @@ steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std
                     &m.min_cell_ratio}) {
     clean(*v);
   }
+}
+
+}  // namespace
+
+steadiface::StabilizerState ToMsg(const steadiface::PipelineFrame& pf, const std_msgs::Header& header,
+                                  bool gyro_extrapolated) {
+  const steadiface::StabilizerFrame& f = pf.stabilizer;
+  steadiface::StabilizerState m;
+  m.header = header;
+  m.has_target = f.has_target;
+  m.target_h = {f.H.x(), f.H.y()};
+  m.centre_c = {f.C.x(), f.C.y()};
+  m.virtual_rotation = ToMsg(f.R_v);
+  m.real_rotation = ToMsg(f.R_r);
+  m.principal_offset = {f.t.x(), f.t.y()};
+  FillTermsAndSolver(f, &m);
+  FillFaceAndFlags(pf, &m);
+  m.gyro_extrapolated = gyro_extrapolated;
+  FillLayers(pf, &m);
+  FillGyroVideoCheck(pf, &m);
+  m.face_ms = pf.timings.face_ms;
+  m.stabilizer_ms = pf.timings.stabilizer_ms;
+  m.warp_ms = pf.timings.mesh_ms + pf.timings.maps_ms + pf.timings.remap_ms;
+  m.total_ms = pf.timings.total_ms;
+  ZeroNonFinite(&m);
   return m;
 }
 
