@@ -20,10 +20,7 @@
 namespace steadiface {
 namespace {
 
-std::unique_ptr<sim::Simulator> Make(const std::string& preset,
-                                     std::function<void(sim::SimulatorOptions*)> tweak = {}) {
-  return testing_util::MakeSimulator(preset, tweak);
-}
+using testing_util::MakeSimulator;
 
 eval::Score Score(const sim::Simulator& s, eval::Method m) {
   const PipelineOptions o = eval::OptionsFor(s, m);
@@ -61,7 +58,7 @@ class LayeredScorecardTest : public ::testing::TestWithParam<LayeredCase> {};
 // in the steady scene, not more.
 TEST_P(LayeredScorecardTest, NeverMovesTheBackgroundAndHoldsTheHead) {
   const LayeredCase& c = GetParam();
-  const auto s = Make(c.preset, [&](sim::SimulatorOptions* o) {
+  const auto s = MakeSimulator(c.preset, [&](sim::SimulatorOptions* o) {
     // As steadiface_evaluate: a preset replaying the recorded trace runs its
     // whole length.
     if (c.preset == "shake" || c.preset == "run") o->duration_s = 9.8;
@@ -123,7 +120,7 @@ INSTANTIATE_TEST_SUITE_P(
 // background layer's mesh), and the blend comes back when the face does,
 // never stepping by more than dt / ramp.
 TEST(LayeredWarpTest, FaceLossReturnsToOneGlobalWarpWithoutAJump) {
-  const auto s = Make("walk", [](sim::SimulatorOptions* o) {
+  const auto s = MakeSimulator("walk", [](sim::SimulatorOptions* o) {
     o->duration_s = 4.0;
     o->face_out_start_s = 0.8;
     o->face_out_end_s = 2.0;

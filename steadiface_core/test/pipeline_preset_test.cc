@@ -20,10 +20,7 @@
 namespace steadiface {
 namespace {
 
-std::unique_ptr<sim::Simulator> Make(const std::string& preset,
-                                     std::function<void(sim::SimulatorOptions*)> tweak = {}) {
-  return testing_util::MakeSimulator(preset, tweak);
-}
+using testing_util::MakeSimulator;
 
 struct PresetResult {
   eval::Score none, gyro, full;
@@ -32,7 +29,7 @@ struct PresetResult {
 // `crop_ratio` < 0: the package default; `duration_s` < 0: the simulator's.
 PresetResult Score(const std::string& preset, double crop_ratio = -1.0,
                    double duration_s = -1.0) {
-  auto s = Make(preset, [duration_s](sim::SimulatorOptions* o) {
+  auto s = MakeSimulator(preset, [duration_s](sim::SimulatorOptions* o) {
     if (duration_s > 0.0) o->duration_s = duration_s;
   });
   PresetResult r;
@@ -126,7 +123,7 @@ TEST(PipelinePresetTest, ALargerCropRemovesMoreOfTheRunningShake) {
 // stabilizer fades to gyro-only while the face is out and back in after it
 // returns, with bounded per-frame weight steps and no undefined pixels.
 TEST(PipelinePresetTest, FaceLeavingAndReenteringFadesWithoutJumps) {
-  auto s = Make("walk", [](sim::SimulatorOptions* o) {
+  auto s = MakeSimulator("walk", [](sim::SimulatorOptions* o) {
     o->duration_s = 4.0;
     o->face_out_start_s = 1.2;
     o->face_out_end_s = 2.4;
@@ -165,7 +162,7 @@ TEST(PipelinePresetTest, FaceLeavingAndReenteringFadesWithoutJumps) {
 // A global brightness change mid-sequence (auto exposure): the face stays
 // tracked through it, and the head stays steadier than gyro-only.
 TEST(PipelinePresetTest, BrightnessChangeKeepsTheFace) {
-  auto s = Make("walk", [](sim::SimulatorOptions* o) { o->brightness_change_s = 1.5; });
+  auto s = MakeSimulator("walk", [](sim::SimulatorOptions* o) { o->brightness_change_s = 1.5; });
   int changed = 0;
   for (int i = 0; i < s->num_frames(); ++i) changed += s->Truth(i).brightness_changed ? 1 : 0;
   EXPECT_GT(changed, 10);

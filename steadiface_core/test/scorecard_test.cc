@@ -19,13 +19,10 @@
 namespace steadiface {
 namespace {
 
-std::unique_ptr<sim::Simulator> Make(const std::string& preset,
-                                     std::function<void(sim::SimulatorOptions*)> tweak = {}) {
-  return testing_util::MakeSimulator(preset, tweak);
-}
+using testing_util::MakeSimulator;
 
 TEST(ScorecardTest, IdentityOnAStillSceneScoresZeroJitter) {
-  auto s = Make("still", [](sim::SimulatorOptions* o) {
+  auto s = MakeSimulator("still", [](sim::SimulatorOptions* o) {
     o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
     o->head.yaw_amplitude_rad = o->head.pitch_amplitude_rad = o->head.lean_amplitude_m = 0.0;
   });
@@ -42,7 +39,7 @@ TEST(ScorecardTest, IdentityOnAStillSceneScoresZeroJitter) {
 }
 
 TEST(ScorecardTest, AWarpThatCancelsTheTrueMotionScoresNearZero) {
-  auto s = Make("walk");
+  auto s = MakeSimulator("walk");
   std::unique_ptr<eval::Scorecard> scorecard;
   ASSERT_TRUE(eval::MakeScorecard(*s, PipelineOptions(), &scorecard).ok());
   eval::Scorecard& card = *scorecard;
@@ -64,7 +61,7 @@ TEST(ScorecardTest, AWarpThatCancelsTheTrueMotionScoresNearZero) {
 }
 
 TEST(ScorecardTest, AddedJitterRaisesTheScoreByTheExpectedAmount) {
-  auto s = Make("still", [](sim::SimulatorOptions* o) {
+  auto s = MakeSimulator("still", [](sim::SimulatorOptions* o) {
     o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
     o->head.yaw_amplitude_rad = o->head.pitch_amplitude_rad = o->head.lean_amplitude_m = 0.0;
   });
@@ -99,11 +96,11 @@ TEST(ScorecardTest, ThePanItselfScoresMostOfThePanPresetsBackgroundJitter) {
     for (int i = 0; i < s.num_frames(); ++i) card->Add(i, eval::FrameWarp());
     return card->Compute().background_jitter_px;
   };
-  const double pan_only = input_background(*Make("pan", [](sim::SimulatorOptions* o) {
+  const double pan_only = input_background(*MakeSimulator("pan", [](sim::SimulatorOptions* o) {
     o->camera.shake_rms_rad = 0.0;
     o->camera.translation_rms_m = 0.0;
   }));
-  const double preset = input_background(*Make("pan"));
+  const double preset = input_background(*MakeSimulator("pan"));
   std::cout << "[ pan ] input background jitter: pan alone " << pan_only << " px, preset "
             << preset << " px\n";
   EXPECT_NEAR(pan_only, 4.0, 0.3);
@@ -118,7 +115,7 @@ TEST(ScorecardTest, ThePanItselfScoresMostOfThePanPresetsBackgroundJitter) {
 // the background floor is 0 for the input and the whole relative jitter when
 // the head is held.
 TEST(ScorecardTest, RelativeJitterIsFixedByTheSceneAndBoundsTheBackground) {
-  auto s = Make("still");
+  auto s = MakeSimulator("still");
   const Eigen::Vector2d head0 = s->Truth(0).head_px;
   auto score = [&](auto shift_of_frame) {
     std::unique_ptr<eval::Scorecard> card;

@@ -17,10 +17,7 @@
 namespace steadiface {
 namespace {
 
-std::unique_ptr<sim::Simulator> Make(const std::string& preset,
-                                     std::function<void(sim::SimulatorOptions*)> tweak = {}) {
-  return testing_util::MakeSimulator(preset, tweak);
-}
+using testing_util::MakeSimulator;
 
 sim::HeadMotionOptions StillHead() {
   sim::HeadMotionOptions h;
@@ -50,7 +47,7 @@ TEST(SimPresetsTest, HeadDriftAndWalkFollowTheirClosedForms) {
 }
 
 TEST(SimPresetsTest, DriftIsASmallTremorWhileTheHeadDriftsAndTurns) {
-  auto s = Make("drift");
+  auto s = MakeSimulator("drift");
   const int n = s->num_frames();
   ASSERT_EQ(n, 90);
   // The camera's tremor: the true rotation's deviation from its mean,
@@ -72,7 +69,7 @@ TEST(SimPresetsTest, DriftIsASmallTremorWhileTheHeadDriftsAndTurns) {
   }
   // With the camera frozen, the head still crosses tens of pixels: the
   // drift (5 cm at 0.6 m) and the turning, against a still scene.
-  auto frozen = Make("drift", [](sim::SimulatorOptions* o) {
+  auto frozen = MakeSimulator("drift", [](sim::SimulatorOptions* o) {
     o->camera.shake_rms_rad = 0.0;
     o->camera.translation_rms_m = 0.0;
   });
@@ -87,7 +84,7 @@ TEST(SimPresetsTest, DriftIsASmallTremorWhileTheHeadDriftsAndTurns) {
 }
 
 TEST(SimPresetsTest, WalkAcrossCrossesTheViewWithTheFaceInView) {
-  auto s = Make("walk_across");
+  auto s = MakeSimulator("walk_across");
   const int n = s->num_frames();
   const double w = s->intrinsics().width;
   const sim::SimTruth first = s->Truth(0), last = s->Truth(n - 1);

@@ -14,14 +14,11 @@
 namespace steadiface {
 namespace {
 
-std::unique_ptr<sim::Simulator> Make(const std::string& preset,
-                                     std::function<void(sim::SimulatorOptions*)> tweak = {}) {
-  return testing_util::MakeSimulator(preset, tweak);
-}
+using testing_util::MakeSimulator;
 
 TEST(SimulatorTest, SameSeedGivesByteIdenticalFramesImuAndTruth) {
-  auto a = Make("occlusion");
-  auto b = Make("occlusion");
+  auto a = MakeSimulator("occlusion");
+  auto b = MakeSimulator("occlusion");
   ASSERT_EQ(a->imu().size(), b->imu().size());
   for (size_t i = 0; i < a->imu().size(); ++i) {
     ASSERT_EQ(a->imu()[i].stamp, b->imu()[i].stamp);
@@ -37,13 +34,13 @@ TEST(SimulatorTest, SameSeedGivesByteIdenticalFramesImuAndTruth) {
     EXPECT_EQ(ta.R_r.back().coeffs(), tb.R_r.back().coeffs());
   }
   // Another seed differs.
-  auto c = Make("occlusion", [](sim::SimulatorOptions* o) { o->seed = 2; });
+  auto c = MakeSimulator("occlusion", [](sim::SimulatorOptions* o) { o->seed = 2; });
   EXPECT_NE(c->imu()[10].angular_velocity, a->imu()[10].angular_velocity);
 }
 
 TEST(SimulatorTest, WithoutCameraMotionTheHeadCentreFollowsOnlyTheHead) {
   // Still camera, head moving: the background never moves, the head does.
-  auto s = Make("still");
+  auto s = MakeSimulator("still");
   Eigen::Vector2d bg0, h0 = s->Truth(0).head_px;
   ASSERT_TRUE(s->BackgroundPixel(0, Eigen::Vector3d(0.1, 0.05, 1), &bg0));
   double head_motion = 0.0;
@@ -55,7 +52,7 @@ TEST(SimulatorTest, WithoutCameraMotionTheHeadCentreFollowsOnlyTheHead) {
   }
   EXPECT_GT(head_motion, 5.0);
   // And with the head frozen too, the head centre is fixed.
-  auto frozen = Make("still", [](sim::SimulatorOptions* o) {
+  auto frozen = MakeSimulator("still", [](sim::SimulatorOptions* o) {
     o->head = sim::HeadMotionOptions();
     o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
     o->head.yaw_amplitude_rad = o->head.pitch_amplitude_rad = o->head.lean_amplitude_m = 0.0;
@@ -69,7 +66,7 @@ TEST(SimulatorTest, WithoutCameraMotionTheHeadCentreFollowsOnlyTheHead) {
 TEST(SimulatorTest, PureRotationMovesTheSceneByKRKinv) {
   // Shake only (no translation, no body or head motion), global shutter:
   // every point, near or far, moves by K R K^-1 between frames.
-  auto s = Make("walk", [](sim::SimulatorOptions* o) {
+  auto s = MakeSimulator("walk", [](sim::SimulatorOptions* o) {
     o->camera.translation_rms_m = 0.0;
     o->body_bob_m = o->body_sway_m = 0.0;
     o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
@@ -104,7 +101,7 @@ TEST(SimulatorTest, PureRotationMovesTheSceneByKRKinv) {
 }
 
 TEST(SimulatorTest, IntegratedImuReproducesTheTrueOrientation) {
-  auto s = Make("walk", [](sim::SimulatorOptions* o) { o->imu_clock_offset_s = 0.012; });
+  auto s = MakeSimulator("walk", [](sim::SimulatorOptions* o) { o->imu_clock_offset_s = 0.012; });
   OrientationTimelineOptions to;
   to.imu_time_offset_s = 0.012;
   OrientationTimeline tl(to);
@@ -130,8 +127,8 @@ TEST(SimulatorTest, IntegratedImuReproducesTheTrueOrientation) {
 // normal-speed one at k t (same amplitude), the IMU reads k times the
 // angular velocity, and integrating it reproduces the true orientation.
 TEST(SimulatorTest, RealGyroSpeedPlaysTheTraceFasterWithTheSameAmplitude) {
-  auto normal = Make("run", [](sim::SimulatorOptions* o) { o->gyro_noise = 0.0; });
-  auto fast = Make("run", [](sim::SimulatorOptions* o) {
+  auto normal = MakeSimulator("run", [](sim::SimulatorOptions* o) { o->gyro_noise = 0.0; });
+  auto fast = MakeSimulator("run", [](sim::SimulatorOptions* o) {
     o->gyro_noise = 0.0;
     o->real_gyro_speed = 2.5;
   });
@@ -168,7 +165,7 @@ TEST(SimulatorTest, RealGyroSpeedPlaysTheTraceFasterWithTheSameAmplitude) {
 
 TEST(SimulatorTest, PresetsAndErrors) {
   for (const auto& p : sim::PresetNames()) {
-    auto s = Make(p);
+    auto s = MakeSimulator(p);
     ASSERT_NE(s, nullptr) << p;
     EXPECT_EQ(s->num_frames(), 90);
   }
@@ -189,7 +186,7 @@ namespace {
 // subject mask (SubjectCovers) holds the face and the torso below it, not
 // the background beside them, and the torso moves with the head.
 TEST(SimulatorTest, VlogHasATorsoUnderTheFaceAndASubjectMask) {
-  auto s = Make("vlog");
+  auto s = MakeSimulator("vlog");
   ASSERT_TRUE(s->options().render_torso);
   for (int i : {0, 45}) {
     const sim::SimTruth t = s->Truth(i);
@@ -205,7 +202,7 @@ TEST(SimulatorTest, VlogHasATorsoUnderTheFaceAndASubjectMask) {
     EXPECT_FALSE(s->SubjectCovers(i, Eigen::Vector2d(5, 5)));
   }
   // The walk preset has no torso: below the face is background.
-  auto walk = Make("walk");
+  auto walk = MakeSimulator("walk");
   const sim::SimTruth t = walk->Truth(0);
   EXPECT_FALSE(walk->SubjectCovers(0, t.head_px + Eigen::Vector2d(0.6 * t.face_scale_px,
                                                                     1.2 * t.face_scale_px)));
