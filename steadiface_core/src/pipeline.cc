@@ -62,9 +62,9 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
   CameraModel model;
   s = CameraModel::Create(intrinsics, options.camera, &model);
   if (!s.ok()) return s;
-  PipelineOptions o = options;
-  o.stabilizer = ForWarp(options.stabilizer, o.warp);
-  std::unique_ptr<Pipeline> p(new Pipeline(model, o));
+  // options_ keeps the stabilizer options as requested; the stabilizer
+  // gets them as the warp needs them (ForWarp), derived anew on every change.
+  std::unique_ptr<Pipeline> p(new Pipeline(model, options));
   if (options.landmark_source != LandmarkSource::kNone) {
     // External landmarks still go through the tracker's checks and
     // face-of-interest logic (no model file needed for them, but the
@@ -73,7 +73,8 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
     s = FaceTracker::Create(model, fo, &p->tracker_);
     if (!s.ok()) return s;
   }
-  s = Stabilizer::Create(model, options.warp.output, o.stabilizer, &p->stabilizer_);
+  s = Stabilizer::Create(model, options.warp.output, ForWarp(options.stabilizer, options.warp),
+                         &p->stabilizer_);
   if (!s.ok()) return s;
   s = Warper::Create(model, options.warp, &p->warper_);
   if (!s.ok()) return s;
@@ -267,9 +268,8 @@ Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
 }
 
 Status Pipeline::UpdateStabilizerOptions(const StabilizerOptions& options) {
-  const StabilizerOptions o = ForWarp(options, options_.warp);
-  Status s = stabilizer_->UpdateOptions(o);
-  if (s.ok()) options_.stabilizer = o;
+  Status s = stabilizer_->UpdateOptions(ForWarp(options, options_.warp));
+  if (s.ok()) options_.stabilizer = options;
   return s;
 }
 
@@ -280,12 +280,13 @@ Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered
   std::unique_ptr<Warper> warper;
   Status s = Warper::Create(model_, w, &warper);
   if (!s.ok()) return s;
-  const StabilizerOptions so = ForWarp(options_.stabilizer, w);
-  if (so.background_layer != options_.stabilizer.background_layer ||
-      so.subject_reach != options_.stabilizer.subject_reach) {
-    s = stabilizer_->UpdateOptions(so);
+  // The stabilizer's layered options follow the new warp (the reach from the
+  // new band width and cap).
+  const StabilizerOptions now = ForWarp(options_.stabilizer, options_.warp);
+  const StabilizerOptions next = ForWarp(options_.stabilizer, w);
+  if (next.background_layer != now.background_layer || next.subject_reach != now.subject_reach) {
+    s = stabilizer_->UpdateOptions(next);
     if (!s.ok()) return s;
-    options_.stabilizer = so;
   }
   warper_ = std::move(warper);
   options_.warp = w;

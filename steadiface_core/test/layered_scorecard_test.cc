@@ -115,6 +115,32 @@ INSTANTIATE_TEST_SUITE_P(
                       LayeredCase{"shake", 0.9, 25.0}),
     [](const ::testing::TestParamInfo<LayeredCase>& info) { return info.param.preset; });
 
+// The pipeline keeps the stabilizer options as requested and derives the
+// layered ones from the warp each time: the reach follows a reconfigured
+// band (width x cap), a stabilizer update keeps it, and global mode drops
+// the background layer that only layered mode asked for.
+TEST(LayeredWarpTest, TheReachFollowsTheBandWhenReconfigured) {
+  const auto s = MakeSimulator("walk");
+  const PipelineOptions o = eval::OptionsFor(*s, eval::Method::kSteadifaceLayered);
+  ASSERT_EQ(o.stabilizer.subject_reach, 0.0);
+  ASSERT_FALSE(o.stabilizer.background_layer);
+  std::unique_ptr<Pipeline> p;
+  ASSERT_TRUE(Pipeline::Create(s->intrinsics(), o, &p).ok());
+  const LayerBlendOptions& b = o.warp.layered.blend;
+  EXPECT_DOUBLE_EQ(p->stabilizer().options().subject_reach, b.band_width * b.max_offset);
+  EXPECT_TRUE(p->stabilizer().options().background_layer);
+  EXPECT_EQ(p->options().stabilizer.subject_reach, 0.0);  // as requested
+  LayeredWarpOptions wider = o.warp.layered;
+  wider.blend.band_width = 0.5;
+  ASSERT_TRUE(p->UpdateLayering(WarpMode::kLayered, wider).ok());
+  EXPECT_DOUBLE_EQ(p->stabilizer().options().subject_reach, 0.5 * b.max_offset);
+  ASSERT_TRUE(p->UpdateStabilizerOptions(p->options().stabilizer).ok());
+  EXPECT_DOUBLE_EQ(p->stabilizer().options().subject_reach, 0.5 * b.max_offset);
+  ASSERT_TRUE(p->UpdateLayering(WarpMode::kGlobal, wider).ok());
+  EXPECT_FALSE(p->stabilizer().options().background_layer);
+  EXPECT_EQ(p->stabilizer().options().subject_reach, 0.0);
+}
+
 // When the face is lost (it leaves the frame sideways for about a second)
 // the blend ramps to 0, the output becomes one global warp (exactly the
 // background layer's mesh), and the blend comes back when the face does,

@@ -91,7 +91,6 @@ void StabilizerWrapper::ApplyPendingOptions() {
         sink_->Error("reconfigure", "reconfigure rejected: " + s.message());
         return;
       }
-      options_.stabilizer.background_layer = pipeline_->options().stabilizer.background_layer;
     }
     options_.warp.mode = mode;
     options_.warp.layered = layered;
@@ -103,8 +102,8 @@ void StabilizerWrapper::ApplyPendingOptions() {
       sink_->Error("reconfigure", "reconfigure rejected: " + s.message());
       return;
     }
-    o = pipeline_->options().stabilizer;  // layered mode keeps its background layer
   }
+  // As requested: the pipeline derives what layered mode adds to them.
   options_.stabilizer = o;
 }
 
