@@ -12,9 +12,9 @@
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 
+#include "steadiface_core/common/percentile.h"
 #include "steadiface_core/eval/run_methods.h"
-#include "steadiface_core/percentile.h"
-#include "steadiface_core/pipeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
 
 namespace steadiface {

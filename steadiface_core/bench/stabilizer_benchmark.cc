@@ -6,7 +6,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "steadiface_core/percentile.h"
+#include "steadiface_core/common/percentile.h"
 
 #include "steadiface_core/sim/landmark_sequence.h"
 #include "steadiface_core/stabilizer/stabilizer.h"

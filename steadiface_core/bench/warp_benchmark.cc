@@ -6,9 +6,9 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "steadiface_core/mesh_sampler.h"
-#include "steadiface_core/so3.h"
-#include "steadiface_core/warper.h"
+#include "steadiface_core/common/so3.h"
+#include "steadiface_core/warp/mesh_sampler.h"
+#include "steadiface_core/warp/warper.h"
 
 namespace steadiface {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <Eigen/Core>
 
-#include "steadiface_core/warper.h"
+#include "steadiface_core/warp/warper.h"
 
 namespace steadiface {
 namespace testing_util {

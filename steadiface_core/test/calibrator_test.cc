@@ -13,7 +13,7 @@
 
 #include "steadiface_core/calibration/calibrator.h"
 #include "steadiface_core/calibration/gyro_integral.h"
-#include "steadiface_core/calibration/gyro_video_check.h"
+#include "steadiface_core/check/gyro_video_check.h"
 #include "steadiface_core/sim/simulator.h"
 
 namespace steadiface {

@@ -1,8 +1,8 @@
-#include "steadiface_core/camera_model.h"
+#include "steadiface_core/camera/camera_model.h"
 
 #include <gtest/gtest.h>
 
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/so3.h"
 
 namespace steadiface {
 namespace {

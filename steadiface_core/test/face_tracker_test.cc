@@ -6,10 +6,10 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "steadiface_core/face/head_pose.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/face/generic_face.h"
+#include "steadiface_core/face/head_pose.h"
 #include "steadiface_core/sim/scene_renderer.h"
-#include "steadiface_core/so3.h"
 #include "test_util.h"
 
 namespace steadiface {

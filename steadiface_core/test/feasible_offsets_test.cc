@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
-#include "steadiface_core/so3.h"
-#include "steadiface_core/warp_geometry.h"
+#include "steadiface_core/common/so3.h"
+#include "steadiface_core/warp/warp_geometry.h"
 #include "test_util.h"
 
 namespace steadiface {

@@ -2,7 +2,7 @@
 // re-expressed in a permuted IMU frame, or shifted by a clock offset, and
 // the check must say so (and name the right mounting / offset) within a few
 // seconds; with the right configuration it must stay quiet.
-#include "steadiface_core/calibration/gyro_video_check.h"
+#include "steadiface_core/check/gyro_video_check.h"
 
 #include <iostream>
 #include <memory>

@@ -11,11 +11,11 @@
 
 #include <gtest/gtest.h>
 
+#include "sim_util.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/scorecard.h"
-#include "steadiface_core/pipeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
-#include "sim_util.h"
 
 namespace steadiface {
 namespace {

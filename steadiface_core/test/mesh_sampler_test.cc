@@ -1,7 +1,7 @@
 // The warp kernels' own tests: the scan set-up's rounding and the shuffle
 // kernels against the portable one. (WarperTest.DirectSamplingIsRemapBitForBit
 // ties the portable kernel to cv::remap through the Warper.)
-#include "steadiface_core/mesh_sampler.h"
+#include "steadiface_core/warp/mesh_sampler.h"
 
 #include <cmath>
 #include <cstring>
@@ -10,9 +10,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "affine_mesh.h"
-#include "steadiface_core/mesh_scanline.h"
-#include "steadiface_core/warper.h"
+#include "steadiface_core/warp/warper.h"
 #include "test_util.h"
+#include "warp/mesh_scanline.h"
 
 namespace steadiface {
 namespace {

@@ -18,10 +18,10 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "face/landmark_predictor_impl.h"
+#include "steadiface_core/common/model_cache.h"
 #include "steadiface_core/face/face_detector.h"
 #include "steadiface_core/face/landmark_predictor.h"
-#include "steadiface_core/face/landmark_predictor_impl.h"
-#include "steadiface_core/model_cache.h"
 #include "test_util.h"
 
 namespace steadiface {

@@ -15,7 +15,7 @@
 
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/scorecard.h"
-#include "steadiface_core/pipeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
 
 namespace steadiface {

@@ -1,11 +1,11 @@
-#include "steadiface_core/orientation_timeline.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
 
 #include <cmath>
 #include <limits>
 
 #include <gtest/gtest.h>
 
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/so3.h"
 
 namespace steadiface {
 namespace {

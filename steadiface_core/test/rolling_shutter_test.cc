@@ -1,9 +1,9 @@
-#include "steadiface_core/rolling_shutter.h"
+#include "steadiface_core/camera/rolling_shutter.h"
 
 #include <gtest/gtest.h>
 
-#include "steadiface_core/row_rotations.h"
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/so3.h"
+#include "steadiface_core/gyro/row_rotations.h"
 
 namespace steadiface {
 namespace {

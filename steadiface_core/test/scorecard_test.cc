@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include "sim_util.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/scorecard.h"
-#include "steadiface_core/pipeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
-#include "steadiface_core/so3.h"
-#include "sim_util.h"
 #include "test_util.h"
 
 namespace steadiface {

@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
+#include "sim_util.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/sim/motion.h"
 #include "steadiface_core/sim/simulator.h"
-#include "steadiface_core/so3.h"
-#include "sim_util.h"
 
 namespace steadiface {
 namespace {

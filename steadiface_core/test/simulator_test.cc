@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "sim_util.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/scorecard.h"
-#include "steadiface_core/so3.h"
-#include "sim_util.h"
 #include "test_util.h"
 
 namespace steadiface {

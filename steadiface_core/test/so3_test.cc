@@ -1,4 +1,4 @@
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/so3.h"
 
 #include <gtest/gtest.h>
 

@@ -13,8 +13,8 @@
 #include <ceres/autodiff_cost_function.h>
 #include <gtest/gtest.h>
 
-#include "steadiface_core/ceres_compat.h"
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/ceres_compat.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/stabilizer/distortion_cost.h"
 #include "steadiface_core/stabilizer/fitting_cost.h"
 #include "steadiface_core/stabilizer/following_cost.h"

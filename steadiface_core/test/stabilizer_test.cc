@@ -11,9 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/sim/landmark_sequence.h"
 #include "steadiface_core/stabilizer/face_in_camera.h"
-#include "steadiface_core/so3.h"
 #include "test_util.h"
 
 namespace steadiface {

@@ -6,8 +6,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "steadiface_core/camera_model.h"
-#include "steadiface_core/time.h"
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/common/time.h"
 
 namespace steadiface {
 namespace testing_util {

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "steadiface_core/tracking_lowpass.h"
+#include "steadiface_core/common/tracking_lowpass.h"
 
 namespace steadiface {
 namespace {

@@ -16,7 +16,7 @@
 
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/face/face_detector.h"
-#include "steadiface_core/pipeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
 
 namespace steadiface {

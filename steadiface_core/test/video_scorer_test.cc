@@ -9,10 +9,10 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/common/percentile.h"
 #include "steadiface_core/eval/ffmpeg_baseline.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/video_scorer.h"
-#include "steadiface_core/percentile.h"
 #include "test_util.h"
 
 namespace steadiface {

@@ -1,4 +1,4 @@
-#include "steadiface_core/warper.h"
+#include "steadiface_core/warp/warper.h"
 
 #include <cmath>
 #include <random>
@@ -7,9 +7,9 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "steadiface_core/debug_overlay.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/sim/background.h"
-#include "steadiface_core/so3.h"
+#include "steadiface_core/warp/debug_overlay.h"
 #include "test_util.h"
 
 namespace steadiface {

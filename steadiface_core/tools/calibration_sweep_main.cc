@@ -23,7 +23,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "steadiface_core/calibration/calibrator.h"
-#include "steadiface_core/calibration/gyro_video_check.h"
+#include "steadiface_core/check/gyro_video_check.h"
 #include "steadiface_core/sim/simulator.h"
 
 namespace {

@@ -9,7 +9,7 @@
 #include <sensor_msgs/image_encodings.h>
 
 #include "image_decoder.h"
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_ros/time_conversion.h"
 
 namespace steadiface_ros {

@@ -1,5 +1,5 @@
 // The warp kernels on AArch64 (run under qemu-user by scripts/dev/check_aarch64,
-// which cross-compiles this file with steadiface_core/src/mesh_sampler.cc):
+// which cross-compiles this file with steadiface_core/src/warp/mesh_sampler.cc):
 // the shuffle kernels (NEON tbl, umull + addp) against the portable
 // universal-intrinsics kernel and against an independent scalar
 // implementation of cv::remap's fixed-point bilinear arithmetic, bit for
@@ -15,10 +15,10 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/mesh_sampler.h"
-#include "steadiface_core/mesh_scanline.h"
-#include "steadiface_core/warper.h"
 #include "affine_mesh.h"
+#include "steadiface_core/warp/mesh_sampler.h"
+#include "steadiface_core/warp/warper.h"
+#include "warp/mesh_scanline.h"
 
 namespace {
 

@@ -4,9 +4,9 @@
 #include <cstdlib>
 
 #include "fuzz_util.h"
-#include "steadiface_core/orientation_timeline.h"
-#include "steadiface_core/rolling_shutter.h"
-#include "steadiface_core/row_rotations.h"
+#include "steadiface_core/camera/rolling_shutter.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
+#include "steadiface_core/gyro/row_rotations.h"
 
 using namespace steadiface;  // NOLINT (test harness)
 

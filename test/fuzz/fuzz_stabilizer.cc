@@ -5,7 +5,7 @@
 
 #include "fuzz_util.h"
 #include "steadiface_core/stabilizer/stabilizer.h"
-#include "steadiface_core/warper.h"
+#include "steadiface_core/warp/warper.h"
 
 using namespace steadiface;  // NOLINT (test harness)
 

@@ -13,12 +13,12 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "steadiface_core/calibration/gyro_integral.h"
-#include "steadiface_core/calibration/gyro_video_check.h"
-#include "steadiface_core/ceres_compat.h"
-#include "steadiface_core/grey.h"
-#include "steadiface_core/lens_distortion.h"
-#include "steadiface_core/percentile.h"
-#include "steadiface_core/so3.h"
+#include "steadiface_core/camera/lens_distortion.h"
+#include "steadiface_core/check/gyro_video_check.h"
+#include "steadiface_core/common/ceres_compat.h"
+#include "steadiface_core/common/grey.h"
+#include "steadiface_core/common/percentile.h"
+#include "steadiface_core/common/so3.h"
 
 namespace steadiface {
 namespace {

@@ -1,7 +1,7 @@
 #include "steadiface_core/eval/scorecard.h"
 
-#include "steadiface_core/high_pass_rms.h"
-#include "steadiface_core/percentile.h"
+#include "steadiface_core/common/high_pass_rms.h"
+#include "steadiface_core/common/percentile.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +11,8 @@
 #include <Eigen/Eigenvalues>
 #include <opencv2/core.hpp>
 
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/layered/layer_blend.h"
-#include "steadiface_core/so3.h"
 
 namespace steadiface {
 namespace eval {

@@ -6,8 +6,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "steadiface_core/high_pass_rms.h"
-#include "steadiface_core/percentile.h"
+#include "steadiface_core/common/high_pass_rms.h"
+#include "steadiface_core/common/percentile.h"
 
 namespace steadiface {
 namespace eval {

@@ -11,7 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/objdetect.hpp>
 
-#include "steadiface_core/model_cache.h"
+#include "steadiface_core/common/model_cache.h"
 
 namespace steadiface {
 namespace {

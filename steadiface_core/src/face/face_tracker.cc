@@ -7,9 +7,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/camera/lens_distortion.h"
+#include "steadiface_core/common/grey.h"
 #include "steadiface_core/face/head_pose.h"
-#include "steadiface_core/grey.h"
-#include "steadiface_core/lens_distortion.h"
 
 namespace steadiface {
 namespace {

@@ -13,8 +13,8 @@
 #include <sstream>
 #include <string>
 
-#include "steadiface_core/face/landmark_predictor_impl.h"
-#include "steadiface_core/model_cache.h"
+#include "face/landmark_predictor_impl.h"
+#include "steadiface_core/common/model_cache.h"
 
 namespace steadiface {
 

@@ -14,8 +14,8 @@
 #include <dlib/opencv/cv_image.h>
 #include <dlib/serialize.h>
 
-#include "steadiface_core/face/landmark_predictor_impl.h"
-#include "steadiface_core/model_cache.h"
+#include "face/landmark_predictor_impl.h"
+#include "steadiface_core/common/model_cache.h"
 
 namespace steadiface {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/so3.h"
 
 namespace steadiface {
 namespace sim {

@@ -8,7 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/so3.h"
 
 namespace steadiface {
 namespace sim {

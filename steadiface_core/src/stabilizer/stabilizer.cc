@@ -9,8 +9,8 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
-#include "steadiface_core/ceres_compat.h"
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/ceres_compat.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/stabilizer/distortion_cost.h"
 #include "steadiface_core/stabilizer/face_in_camera.h"
 #include "steadiface_core/stabilizer/fitting_cost.h"

@@ -6,7 +6,7 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
-#include "steadiface_core/status.h"
+#include "steadiface_core/common/status.h"
 
 namespace steadiface_ros {
 

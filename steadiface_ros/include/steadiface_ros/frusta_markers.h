@@ -6,7 +6,7 @@
 #include <visualization_msgs/MarkerArray.h>
 #include <Eigen/Geometry>
 
-#include "steadiface_core/camera_intrinsics.h"
+#include "steadiface_core/camera/camera_intrinsics.h"
 
 namespace steadiface_ros {
 

@@ -12,11 +12,11 @@
 
 #include "steadiface/FaceLandmarks.h"
 #include "steadiface/StabilizerState.h"
-#include "steadiface_core/camera_intrinsics.h"
+#include "steadiface_core/camera/camera_intrinsics.h"
+#include "steadiface_core/common/status.h"
 #include "steadiface_core/face/face_types.h"
-#include "steadiface_core/orientation_timeline.h"
-#include "steadiface_core/pipeline.h"
-#include "steadiface_core/status.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 
 namespace steadiface_ros {
 

@@ -7,8 +7,8 @@
 #include <ros/node_handle.h>
 
 #include "steadiface/SteadifaceConfig.h"
-#include "steadiface_core/pipeline.h"
-#include "steadiface_core/status.h"
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/pipeline/pipeline.h"
 
 namespace steadiface_ros {
 

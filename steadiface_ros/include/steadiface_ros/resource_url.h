@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "steadiface_core/status.h"
+#include "steadiface_core/common/status.h"
 
 namespace steadiface_ros {
 

@@ -17,7 +17,7 @@
 
 #include "steadiface/FaceLandmarks.h"
 #include "steadiface/StabilizerState.h"
-#include "steadiface_core/pipeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_ros/frusta_markers.h"
 #include "steadiface_ros/params.h"
 #include "steadiface_ros/render_worker.h"

@@ -2,7 +2,7 @@
 
 #include <ros/time.h>
 
-#include "steadiface_core/time.h"
+#include "steadiface_core/common/time.h"
 
 namespace steadiface_ros {
 

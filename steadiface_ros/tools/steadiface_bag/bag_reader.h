@@ -13,7 +13,7 @@
 #include "steadiface/FaceLandmarks.h"
 #include "steadiface_bag/bounded_queue.h"
 #include "steadiface_bag/indexed_bag_reader.h"
-#include "steadiface_core/status.h"
+#include "steadiface_core/common/status.h"
 
 namespace steadiface_bag {
 

@@ -7,9 +7,9 @@
 #include <sstream>
 #include <vector>
 
-#include "steadiface_core/high_pass_rms.h"
-#include "steadiface_core/percentile.h"
-#include "steadiface_core/so3.h"
+#include "steadiface_core/common/high_pass_rms.h"
+#include "steadiface_core/common/percentile.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_ros/msg_conversion.h"
 
 namespace steadiface_bag {

@@ -5,7 +5,7 @@
 #include <sensor_msgs/CameraInfo.h>
 
 #include "steadiface_bag/bag_writer.h"
-#include "steadiface_core/pipeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_ros/stabilizer_wrapper.h"
 
 namespace steadiface_bag {

@@ -5,7 +5,7 @@
 
 #include <Eigen/Core>
 
-#include "steadiface_core/orientation_timeline.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
 
 namespace steadiface {
 

@@ -2,11 +2,11 @@
 
 #include <vector>
 
-#include "steadiface_core/camera_model.h"
-#include "steadiface_core/output_geometry.h"
-#include "steadiface_core/protrusion.h"
-#include "steadiface_core/row_rotations.h"
-#include "steadiface_core/status.h"
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/gyro/row_rotations.h"
+#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {
 namespace eval {

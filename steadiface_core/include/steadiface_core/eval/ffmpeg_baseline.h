@@ -5,7 +5,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/status.h"
+#include "steadiface_core/common/status.h"
 
 namespace steadiface {
 namespace eval {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "steadiface_core/eval/scorecard.h"
-#include "steadiface_core/pipeline.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
 
 namespace steadiface {

@@ -7,11 +7,11 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "steadiface_core/camera_model.h"
-#include "steadiface_core/output_geometry.h"
-#include "steadiface_core/protrusion.h"
-#include "steadiface_core/row_rotations.h"
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/gyro/row_rotations.h"
 #include "steadiface_core/sim/simulator.h"
+#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {
 namespace eval {

@@ -6,10 +6,10 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/camera_intrinsics.h"
+#include "steadiface_core/camera/camera_intrinsics.h"
+#include "steadiface_core/common/status.h"
 #include "steadiface_core/eval/scorecard.h"
 #include "steadiface_core/face/face_tracker.h"
-#include "steadiface_core/status.h"
 
 namespace steadiface {
 namespace eval {

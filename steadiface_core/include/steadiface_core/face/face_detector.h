@@ -6,8 +6,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "steadiface_core/common/status.h"
 #include "steadiface_core/face/face_types.h"
-#include "steadiface_core/status.h"
 
 namespace steadiface {
 

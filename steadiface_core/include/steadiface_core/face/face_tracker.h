@@ -7,14 +7,14 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/camera_model.h"
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/camera/rolling_shutter.h"
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/common/time.h"
 #include "steadiface_core/face/face_detector.h"
 #include "steadiface_core/face/face_types.h"
 #include "steadiface_core/face/landmark_predictor.h"
-#include "steadiface_core/orientation_timeline.h"
-#include "steadiface_core/rolling_shutter.h"
-#include "steadiface_core/status.h"
-#include "steadiface_core/time.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
 
 namespace steadiface {
 

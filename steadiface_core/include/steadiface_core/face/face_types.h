@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/face_observation.h"
+#include "steadiface_core/face/face_observation.h"
 
 namespace steadiface {
 

@@ -4,7 +4,7 @@
 
 #include <Eigen/Core>
 
-#include "steadiface_core/camera_intrinsics.h"
+#include "steadiface_core/camera/camera_intrinsics.h"
 
 namespace steadiface {
 

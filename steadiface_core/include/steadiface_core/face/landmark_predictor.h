@@ -7,8 +7,8 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/model_cache.h"
-#include "steadiface_core/status.h"
+#include "steadiface_core/common/model_cache.h"
+#include "steadiface_core/common/status.h"
 
 namespace steadiface {
 

@@ -6,9 +6,9 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/common/tracking_lowpass.h"
 #include "steadiface_core/layered/subject_region.h"
-#include "steadiface_core/status.h"
-#include "steadiface_core/tracking_lowpass.h"
 
 namespace steadiface {
 

@@ -3,11 +3,11 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "steadiface_core/camera_model.h"
-#include "steadiface_core/face_observation.h"
-#include "steadiface_core/output_geometry.h"
-#include "steadiface_core/row_rotations.h"
-#include "steadiface_core/status.h"
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/face/face_observation.h"
+#include "steadiface_core/gyro/row_rotations.h"
+#include "steadiface_core/warp/output_geometry.h"
 
 namespace steadiface {
 

@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/camera_intrinsics.h"
+#include "steadiface_core/camera/camera_intrinsics.h"
 
 namespace steadiface {
 namespace sim {

@@ -5,10 +5,10 @@
 
 #include <Eigen/Core>
 
-#include "steadiface_core/camera_model.h"
-#include "steadiface_core/face_observation.h"
-#include "steadiface_core/orientation_timeline.h"
-#include "steadiface_core/rolling_shutter.h"
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/camera/rolling_shutter.h"
+#include "steadiface_core/face/face_observation.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
 #include "steadiface_core/sim/motion.h"
 
 namespace steadiface {

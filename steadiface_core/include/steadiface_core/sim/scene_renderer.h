@@ -6,7 +6,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/camera_intrinsics.h"
+#include "steadiface_core/camera/camera_intrinsics.h"
 #include "steadiface_core/sim/background.h"
 
 namespace steadiface {

@@ -7,12 +7,12 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "steadiface_core/camera_intrinsics.h"
-#include "steadiface_core/orientation_timeline.h"
-#include "steadiface_core/rolling_shutter.h"
+#include "steadiface_core/camera/camera_intrinsics.h"
+#include "steadiface_core/camera/rolling_shutter.h"
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
 #include "steadiface_core/sim/motion.h"
 #include "steadiface_core/sim/scene_renderer.h"
-#include "steadiface_core/status.h"
 
 namespace steadiface {
 namespace sim {

@@ -4,7 +4,7 @@
 
 #include <Eigen/Core>
 
-#include "steadiface_core/face_observation.h"
+#include "steadiface_core/face/face_observation.h"
 #include "steadiface_core/stabilizer/stabilizer_options.h"
 
 namespace steadiface {

@@ -2,7 +2,7 @@
 
 #include <ceres/autodiff_cost_function.h>
 
-#include "steadiface_core/camera_model.h"
+#include "steadiface_core/camera/camera_model.h"
 #include "steadiface_core/stabilizer/quaternion_residuals.h"
 
 namespace steadiface {

@@ -2,7 +2,7 @@
 
 #include <Eigen/Core>
 
-#include "steadiface_core/status.h"
+#include "steadiface_core/common/status.h"
 
 namespace steadiface {
 

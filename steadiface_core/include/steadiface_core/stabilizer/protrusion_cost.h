@@ -4,8 +4,8 @@
 
 #include <ceres/dynamic_autodiff_cost_function.h>
 
-#include "steadiface_core/protrusion.h"
 #include "steadiface_core/stabilizer/quaternion_residuals.h"
+#include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {
 

@@ -6,19 +6,19 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "steadiface_core/camera_model.h"
-#include "steadiface_core/face_observation.h"
-#include "steadiface_core/orientation_timeline.h"
-#include "steadiface_core/output_geometry.h"
-#include "steadiface_core/protrusion.h"
-#include "steadiface_core/rolling_shutter.h"
-#include "steadiface_core/row_rotations.h"
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/camera/rolling_shutter.h"
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/common/time.h"
+#include "steadiface_core/common/tracking_lowpass.h"
+#include "steadiface_core/face/face_observation.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
+#include "steadiface_core/gyro/row_rotations.h"
 #include "steadiface_core/stabilizer/dynamic_weights.h"
 #include "steadiface_core/stabilizer/head_smoother.h"
 #include "steadiface_core/stabilizer/stabilizer_options.h"
-#include "steadiface_core/status.h"
-#include "steadiface_core/time.h"
-#include "steadiface_core/tracking_lowpass.h"
+#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {
 

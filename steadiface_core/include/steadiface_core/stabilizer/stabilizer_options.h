@@ -1,7 +1,7 @@
 #pragma once
 
+#include "steadiface_core/common/status.h"
 #include "steadiface_core/stabilizer/head_smoother.h"
-#include "steadiface_core/status.h"
 
 namespace steadiface {
 

@@ -1,0 +1,194 @@
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/camera/rolling_shutter.h"
+#include "steadiface_core/check/gyro_video_check.h"
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/face/face_tracker.h"
+#include "steadiface_core/gyro/orientation_timeline.h"
+#include "steadiface_core/stabilizer/stabilizer.h"
+#include "steadiface_core/warp/warper.h"
+
+namespace steadiface {
+
+/// Where landmarks come from.
+enum class LandmarkSource {
+  kDlib,      ///< the built-in detector + dlib 68-point tracker
+  kExternal,  ///< landmarks supplied with each frame (another node)
+  kNone,      ///< no face processing: gyro-only stabilization
+};
+
+/// All options of one stream.
+struct PipelineOptions {
+  CameraModelOptions camera;
+  RollingShutterOptions shutter;
+  /// The gyro timeline. Unlike a bare timeline, a stream may extrapolate the
+  /// gyro up to 50 ms past its newest sample: a live node's late frames
+  /// (late_frame_policy "extrapolate") need it.
+  OrientationTimelineOptions imu = [] {
+    OrientationTimelineOptions o;
+    o.max_extrapolation_s = 0.05;
+    return o;
+  }();
+  LandmarkSource landmark_source = LandmarkSource::kDlib;
+  FaceTrackerOptions face;
+  StabilizerOptions stabilizer;
+  WarpOptions warp;
+  /// Produce the stabilized image (false: poses only, e.g. for scoring).
+  bool render_output = true;
+  /// The live check of the gyro's configuration against the video.
+  GyroVideoCheckOptions gyro_video_check;
+};
+
+Status ValidatePipelineOptions(const PipelineOptions& options);
+
+/// The stabilizer options a warp needs: in layered mode the background
+/// layer is solved every frame, and H is held within subject_reach of where
+/// it shows the face; a subject_reach of 0 becomes what the band absorbs,
+/// warp.layered.blend.band_width x max_offset jaw widths.
+StabilizerOptions ForWarp(const StabilizerOptions& options, const WarpOptions& warp);
+
+struct PipelineTimings {
+  double face_ms = 0.0;
+  double check_ms = 0.0;  ///< GyroVideoCheck
+  double stabilizer_ms = 0.0;
+  double mesh_ms = 0.0;
+  double maps_ms = 0.0;
+  double remap_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+/// The layered warp's view of one frame (warp mode layered).
+struct LayeredFrame {
+  bool active = false;  ///< warp mode is layered
+  /// The subject region (output px) and its blend weight.
+  SubjectRegion region;
+  /// What the mesh optimization did (offsets, distortion, timing).
+  LayerBlendReport blend;
+};
+
+/// One processed frame.
+struct PipelineFrame {
+  FaceInfo face;
+  StabilizerFrame stabilizer;
+  /// Stabilized, cropped, scaled output (empty when render_output is off or
+  /// the warp refused the pose).
+  cv::Mat output;
+  /// Intrinsics of `output` (virtual focal and principal offset).
+  CameraIntrinsics output_intrinsics;
+  PipelineTimings timings;
+  /// The gyro-vs-video check over its window (GyroVideoCheck).
+  GyroVideoCheckResult gyro_video_check;
+  /// The clock offset correction the timeline applied to this frame, on top
+  /// of imu/time_offset (gyro_video_check/apply_offset; else 0) [s].
+  double imu_offset_applied_s = 0.0;
+  /// The layered warp (warp mode layered).
+  LayeredFrame layered;
+  /// ProcessFrameDeferred: the frame's warp mesh and output size, for
+  /// RenderDeferred (empty otherwise).
+  WarpMesh mesh;
+  cv::Size output_size;
+};
+
+/// The whole per-frame chain for one camera + IMU stream: gyro timeline,
+/// face information, stabilizer and warp (product steps 1-5). The ROS
+/// nodelet, the offline bag tool and the evaluation tools all drive this
+/// one class; the ROS layer only converts messages.
+///
+/// Causal and deterministic. Not thread-safe: the owner serializes calls.
+class Pipeline {
+ public:
+  static Status Create(const CameraIntrinsics& intrinsics,
+                       const PipelineOptions& options,
+                       std::unique_ptr<Pipeline>* out);
+
+  /// Buffers one gyro sample (rejections are counted in timeline stats).
+  SampleResult AddGyro(const GyroSample& sample);
+
+  /// True when the gyro covers the frame's last row (plus nothing else is
+  /// needed to process it).
+  bool GyroCovers(Time stamp) const;
+  /// Capture time of the frame's last row (camera clock).
+  Time LastRowTime(Time stamp) const { return timing_.LastRowTime(stamp); }
+
+  /// Processes one frame. `external_landmarks` (raw pixels, 68 points, may
+  /// be empty = no face) is used with LandmarkSource::kExternal.
+  Status ProcessFrame(const cv::Mat& image, Time stamp,
+                      const std::vector<Eigen::Vector2d>* external_landmarks,
+                      double external_confidence, PipelineFrame* out);
+
+  /// ProcessFrame without the rendering: `out->mesh` and `out->output_size`
+  /// describe the warp, `out->output` stays empty. RenderDeferred renders it
+  /// later, on any thread, while this pipeline goes on with the next frame
+  /// (a two-stage pipeline; the rendering is SampleMesh, bit-for-bit
+  /// ProcessFrame's with direct sampling or fixed-point maps).
+  Status ProcessFrameDeferred(const cv::Mat& image, Time stamp,
+                              const std::vector<Eigen::Vector2d>* external_landmarks,
+                              double external_confidence, PipelineFrame* out);
+  /// Renders a deferred frame's output from its own mesh (touches no
+  /// pipeline state: thread-safe). Sets timings.remap_ms and adds it to
+  /// timings.total_ms (the frame's work, processing and render).
+  static void RenderDeferred(const cv::Mat& image, PipelineFrame* frame);
+
+  /// Without gyro: the plain centre crop (identity pose), same output size
+  /// and intrinsics as stabilized frames; the trajectory is not touched.
+  Status Passthrough(const cv::Mat& image, PipelineFrame* out);
+
+  /// Replaces the stabilizer's tunable options from the next frame on.
+  Status UpdateStabilizerOptions(const StabilizerOptions& options);
+
+  /// Replaces the warp mode and the layered warp's options from the next
+  /// frame on (rebuilds the warper; switching to layered starts the
+  /// background layer's trajectory). Validated; on error nothing changes.
+  Status UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered);
+
+  /// Time jumped back: forget gyro, face lock, trajectory and the applied
+  /// clock offset correction (a fresh start).
+  void Reset();
+
+  const OrientationTimeline& timeline() const { return timeline_; }
+  const Stabilizer& stabilizer() const { return *stabilizer_; }
+  const Warper& warper() const { return *warper_; }
+  const CameraModel& camera_model() const { return model_; }
+  const RowTiming& row_timing() const { return timing_; }
+  const PipelineOptions& options() const { return options_; }
+
+ private:
+  // ProcessFrame's pieces: the face (tracker or external landmarks; the
+  // grey image the tracker and the check share into *grey; returns the
+  // usable observation, stored in *observation, or null), and the warp (a
+  // pose warp, or the layered mesh; rendered unless deferred).
+  const FaceObservation* FaceStep(const cv::Mat& image, Time stamp,
+                                  const std::vector<Eigen::Vector2d>* external,
+                                  double external_confidence, cv::Mat* grey,
+                                  FaceObservation* observation, PipelineFrame* f);
+  Status WarpStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
+                  PipelineFrame* f);
+  Pipeline(const CameraModel& model, const PipelineOptions& options);
+  void ApplyOffsetEstimate(Time stamp);
+
+  const CameraModel model_;
+  PipelineOptions options_;
+  const RowTiming timing_;
+  OrientationTimeline timeline_;
+  std::unique_ptr<FaceTracker> tracker_;
+  std::unique_ptr<Stabilizer> stabilizer_;
+  std::unique_ptr<Warper> warper_;
+  std::unique_ptr<GyroVideoCheck> check_;  // null when disabled
+  std::unique_ptr<SubjectRegionTracker> region_;  // layered mode
+  bool has_last_stamp_ = false;
+  Time last_stamp_;
+  // gyro_video_check/apply_offset: the previous frame's stamp (rate limit).
+  bool has_check_stamp_ = false;
+  Time check_stamp_;
+  // ProcessFrameDeferred in progress: mesh only, copied into the frame.
+  bool defer_render_ = false;
+};
+
+}  // namespace steadiface

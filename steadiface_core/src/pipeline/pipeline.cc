@@ -1,0 +1,313 @@
+#include "steadiface_core/pipeline/pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "steadiface_core/common/grey.h"
+#include "steadiface_core/warp/mesh_sampler.h"
+
+namespace steadiface {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t)
+      .count();
+}
+
+}  // namespace
+
+Status ValidatePipelineOptions(const PipelineOptions& o) {
+  Status s = ValidateCameraModelOptions(o.camera);
+  if (!s.ok()) return s;
+  s = ValidateRollingShutterOptions(o.shutter);
+  if (!s.ok()) return s;
+  s = ValidateOrientationTimelineOptions(o.imu);
+  if (!s.ok()) return s;
+  if (o.landmark_source == LandmarkSource::kDlib) {
+    s = ValidateFaceTrackerOptions(o.face);
+    if (!s.ok()) return s;
+  }
+  s = ValidateStabilizerOptions(o.stabilizer);
+  if (!s.ok()) return s;
+  s = ValidateGyroVideoCheckOptions(o.gyro_video_check);
+  if (!s.ok()) return s;
+  return ValidateWarpOptions(o.warp);
+}
+
+Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
+    : model_(model),
+      options_(options),
+      timing_(options.shutter, model.intrinsics().height),
+      timeline_(options.imu),
+      region_(new SubjectRegionTracker(options.warp.layered.region)) {}
+
+StabilizerOptions ForWarp(const StabilizerOptions& options, const WarpOptions& warp) {
+  StabilizerOptions o = options;
+  if (warp.mode != WarpMode::kLayered) return o;
+  // The layered warp needs the background layer's pose every frame, and
+  // holds H within what the band absorbs of where that layer shows the face
+  // (unless a reach is given), so the face never moves the background.
+  o.background_layer = true;
+  if (!(o.subject_reach > 0.0)) {
+    o.subject_reach = warp.layered.blend.band_width * warp.layered.blend.max_offset;
+  }
+  return o;
+}
+
+Status Pipeline::Create(const CameraIntrinsics& intrinsics,
+                        const PipelineOptions& options,
+                        std::unique_ptr<Pipeline>* out) {
+  Status s = ValidatePipelineOptions(options);
+  if (!s.ok()) return s;
+  CameraModel model;
+  s = CameraModel::Create(intrinsics, options.camera, &model);
+  if (!s.ok()) return s;
+  // options_ keeps the stabilizer options as requested; the stabilizer
+  // gets them as the warp needs them (ForWarp), derived anew on every change.
+  std::unique_ptr<Pipeline> p(new Pipeline(model, options));
+  if (options.landmark_source != LandmarkSource::kNone) {
+    // External landmarks still go through the tracker's checks and
+    // face-of-interest logic (no model file needed for them, but the
+    // tracker loads it; a missing file is an error only for kDlib).
+    FaceTrackerOptions fo = options.face;
+    s = FaceTracker::Create(model, fo, &p->tracker_);
+    if (!s.ok()) return s;
+  }
+  s = Stabilizer::Create(model, options.warp.output, ForWarp(options.stabilizer, options.warp),
+                         &p->stabilizer_);
+  if (!s.ok()) return s;
+  s = Warper::Create(model, options.warp, &p->warper_);
+  if (!s.ok()) return s;
+  if (options.gyro_video_check.enabled) {
+    s = GyroVideoCheck::Create(model.intrinsics(), p->timing_, options.imu.R_cam_imu.normalized(),
+                               options.gyro_video_check, &p->check_);
+    if (!s.ok()) return s;
+  }
+  *out = std::move(p);
+  return Status::Ok();
+}
+
+SampleResult Pipeline::AddGyro(const GyroSample& sample) {
+  return timeline_.AddSample(sample);
+}
+
+bool Pipeline::GyroCovers(Time stamp) const {
+  return timeline_.Covers(timing_.FirstRowTime(stamp)) &&
+         timeline_.Covers(timing_.LastRowTime(stamp));
+}
+
+Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
+                              const std::vector<Eigen::Vector2d>* external,
+                              double external_confidence, PipelineFrame* out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const CameraIntrinsics& k = model_.intrinsics();
+  if (image.empty() || image.cols != k.width || image.rows != k.height ||
+      image.depth() != CV_8U || image.channels() < 1 || image.channels() > 4) {
+    return Status::Error("pipeline: image must be 8-bit, 1-4 channels, " +
+                         std::to_string(k.width) + "x" + std::to_string(k.height));
+  }
+  PipelineFrame f;
+  // Face information.
+  const auto t_face = std::chrono::steady_clock::now();
+  FaceObservation observation;
+  cv::Mat grey;
+  const FaceObservation* obs =
+      FaceStep(image, stamp, external, external_confidence, &grey, &observation, &f);
+  f.timings.face_ms = MsSince(t_face);
+  // The gyro-vs-video check (never changes the pose), outside the face.
+  if (check_ != nullptr) {
+    const auto t_check = std::chrono::steady_clock::now();
+    check_->Process(grey, stamp, timeline_, f.face.valid ? f.face.box : cv::Rect2d());
+    f.gyro_video_check = check_->result();
+    f.timings.check_ms = MsSince(t_check);
+  }
+  // Stabilizer.
+  const auto t_stab = std::chrono::steady_clock::now();
+  Status s = stabilizer_->Process(stamp, timeline_, timing_, obs, &f.stabilizer);
+  f.timings.stabilizer_ms = MsSince(t_stab);
+  if (!s.ok()) return s;
+  s = WarpStep(image, stamp, obs, &f);
+  if (s.ok() && defer_render_) {
+    f.mesh = warper_->mesh();
+    f.output_size = cv::Size(warper_->output_geometry().width(),
+                             warper_->output_geometry().height());
+  }
+  f.imu_offset_applied_s = timeline_.offset_correction();
+  if (check_ != nullptr && options_.gyro_video_check.apply_offset) ApplyOffsetEstimate(stamp);
+  if (!s.ok()) {
+    f.output.release();
+    *out = std::move(f);
+    return s;
+  }
+  f.timings.total_ms = MsSince(t0);
+  *out = std::move(f);
+  return Status::Ok();
+}
+
+const FaceObservation* Pipeline::FaceStep(const cv::Mat& image, Time stamp,
+                                          const std::vector<Eigen::Vector2d>* external,
+                                          double external_confidence, cv::Mat* grey_out,
+                                          FaceObservation* observation, PipelineFrame* f) {
+  const FaceObservation* obs = nullptr;
+  // The tracker and the check both work on grey: convert once (the same
+  // cv::cvtColor each would run, so their results do not change).
+  const bool internal_face =
+      tracker_ != nullptr && options_.landmark_source != LandmarkSource::kExternal;
+  *grey_out = internal_face ? ToGrey(image) : image;
+  const cv::Mat& grey = *grey_out;
+  if (tracker_ != nullptr) {
+    Status s;
+    if (options_.landmark_source == LandmarkSource::kExternal) {
+      static const std::vector<Eigen::Vector2d> kNone;
+      s = tracker_->ProcessExternal(external != nullptr ? *external : kNone,
+                                    external_confidence, stamp, &timeline_, &timing_,
+                                    &f->face);
+    } else {
+      s = tracker_->Process(grey, stamp, &timeline_, &timing_, &f->face);
+    }
+    // A face error never stops stabilization: it is a frame without a face.
+    if (f->face.valid) {
+      *observation = f->face.ToObservation();
+      obs = observation;
+    }
+  }
+  return obs;
+}
+
+Status Pipeline::WarpStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
+                          PipelineFrame* out) {
+  // The output: one pose warp, or the layered mesh from both layers.
+  PipelineFrame& f = *out;
+  Status s;
+  const bool layered = options_.warp.mode == WarpMode::kLayered;
+  const bool render = options_.render_output && !defer_render_;
+  f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(
+      layered && f.stabilizer.background.valid ? f.stabilizer.background.t : f.stabilizer.t);
+  if (layered) {
+    // The subject region from this frame's face, through the subject layer.
+    const double dt = has_last_stamp_ ? ToSeconds(stamp) - ToSeconds(last_stamp_) : 0.0;
+    f.layered.active = true;
+    f.layered.region = region_->Update(model_, warper_->output_geometry(), f.stabilizer.R_v,
+                                      f.stabilizer.t, f.stabilizer.rows, obs,
+                                      f.stabilizer.factors.presence_target, dt);
+    const StabilizerFrame::LayerPose& b = f.stabilizer.background;
+    s = warper_->ComputeLayeredMesh(f.stabilizer.R_v, f.stabilizer.t, b.valid ? b.R_v : f.stabilizer.R_v,
+                                    b.valid ? b.t : f.stabilizer.t, f.stabilizer.rows,
+                                    f.layered.region, dt);
+    f.layered.blend = warper_->blend_report();
+    f.timings.mesh_ms = warper_->timings().mesh_ms;
+    if (s.ok() && render) {
+      s = warper_->Render(image, &f.output);
+      f.timings.maps_ms = warper_->timings().maps_ms;
+      f.timings.remap_ms = warper_->timings().remap_ms;
+    }
+    has_last_stamp_ = true;
+    last_stamp_ = stamp;
+  } else if (render) {
+    s = warper_->Warp(image, f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows,
+                      &f.output);
+    f.timings.mesh_ms = warper_->timings().mesh_ms;
+    f.timings.maps_ms = warper_->timings().maps_ms;
+    f.timings.remap_ms = warper_->timings().remap_ms;
+  } else if (defer_render_) {
+    s = warper_->ComputeMesh(f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows);
+    f.timings.mesh_ms = warper_->timings().mesh_ms;
+  }
+  return s;
+}
+
+Status Pipeline::ProcessFrameDeferred(const cv::Mat& image, Time stamp,
+                                      const std::vector<Eigen::Vector2d>* external,
+                                      double external_confidence, PipelineFrame* out) {
+  defer_render_ = true;
+  const Status s = ProcessFrame(image, stamp, external, external_confidence, out);
+  defer_render_ = false;
+  return s;
+}
+
+void Pipeline::RenderDeferred(const cv::Mat& image, PipelineFrame* frame) {
+  if (frame->mesh.source.empty() || frame->output_size.area() <= 0) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  SampleMesh(frame->mesh, image, frame->output_size.width, frame->output_size.height,
+             &frame->output);
+  frame->timings.maps_ms = 0.0;
+  frame->timings.remap_ms = MsSince(t0);
+  // The frame's work: processing plus this render (which ran beside the
+  // next frame's processing, so this is not the frame's latency).
+  frame->timings.total_ms += frame->timings.remap_ms;
+}
+
+void Pipeline::ApplyOffsetEstimate(Time stamp) {
+  // The correction follows the check's estimate from the next frame on
+  // (this frame's rows were covered under the old one), rate-limited; it
+  // holds while the check cannot judge or blames the rotation.
+  const GyroVideoCheckOptions& o = options_.gyro_video_check;
+  const double dt = has_check_stamp_ ? ToSeconds(stamp - check_stamp_) : 0.0;
+  has_check_stamp_ = true;
+  check_stamp_ = stamp;
+  const GyroVideoCheckResult& r = check_->result();
+  if (!r.judged || r.rotation_contradicts || !(dt > 0.0)) return;
+  const double target =
+      std::max(-o.offset_range_s, std::min(o.offset_range_s, r.offset_correction_s));
+  const double step = o.apply_rate_s_per_s * std::min(dt, 0.2);
+  const double now = timeline_.offset_correction();
+  timeline_.set_offset_correction(now + std::max(-step, std::min(step, target - now)));
+}
+
+Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
+  PipelineFrame f;
+  const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
+  f.stabilizer.rows = RowRotations(I, model_.intrinsics().height);
+  f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(Eigen::Vector2d::Zero());
+  Status s = warper_->Warp(image, I, Eigen::Vector2d::Zero(), f.stabilizer.rows, &f.output);
+  f.timings.mesh_ms = warper_->timings().mesh_ms;
+  f.timings.maps_ms = warper_->timings().maps_ms;
+  f.timings.remap_ms = warper_->timings().remap_ms;
+  *out = std::move(f);
+  return s;
+}
+
+Status Pipeline::UpdateStabilizerOptions(const StabilizerOptions& options) {
+  Status s = stabilizer_->UpdateOptions(ForWarp(options, options_.warp));
+  if (s.ok()) options_.stabilizer = options;
+  return s;
+}
+
+Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered) {
+  WarpOptions w = options_.warp;
+  w.mode = mode;
+  w.layered = layered;
+  std::unique_ptr<Warper> warper;
+  Status s = Warper::Create(model_, w, &warper);
+  if (!s.ok()) return s;
+  // The stabilizer's layered options follow the new warp (the reach from the
+  // new band width and cap).
+  const StabilizerOptions now = ForWarp(options_.stabilizer, options_.warp);
+  const StabilizerOptions next = ForWarp(options_.stabilizer, w);
+  if (next.background_layer != now.background_layer || next.subject_reach != now.subject_reach) {
+    s = stabilizer_->UpdateOptions(next);
+    if (!s.ok()) return s;
+  }
+  warper_ = std::move(warper);
+  options_.warp = w;
+  region_.reset(new SubjectRegionTracker(layered.region));
+  has_last_stamp_ = false;
+  return Status::Ok();
+}
+
+void Pipeline::Reset() {
+  timeline_.reset();
+  if (tracker_ != nullptr) tracker_->reset();
+  stabilizer_->reset();
+  if (check_ != nullptr) check_->Reset();
+  region_->reset();
+  warper_->reset();
+  has_last_stamp_ = false;
+  // A new epoch starts from the configuration: a replayed bag (rosbag play
+  // --loop) reproduces a fresh start exactly; the check finds the offset
+  // again within seconds.
+  timeline_.set_offset_correction(0.0);
+  has_check_stamp_ = false;
+}
+
+}  // namespace steadiface

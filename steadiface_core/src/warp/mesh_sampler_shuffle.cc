@@ -1,0 +1,384 @@
+#include "warp/mesh_sampler_shuffle.h"
+
+#include <cstdint>
+#include <cstring>
+
+#include <opencv2/core/utility.hpp>
+#if defined(STEADIFACE_SHUFFLE_KERNEL) && \
+    (defined(__x86_64__) || defined(__i386__))
+#include <tmmintrin.h>
+#endif
+
+#include "warp/mesh_sampler_kernels.h"
+
+namespace steadiface {
+namespace mesh_sampler_internal {
+
+#ifndef STEADIFACE_SHUFFLE_KERNEL
+bool ShuffleSupported() { return false; }
+#else
+namespace {
+
+// The two byte operations the shuffle kernel needs, which OpenCV's
+// universal intrinsics do not offer outside OpenCV's own build:
+// ShuffleBytes: r[i] = a[idx[i]] for idx[i] < 16, 0 for idx[i] >= 0x80;
+// MulAddPairs: 16-bit r[i] = a[2i] w[2i] + a[2i+1] w[2i+1], bytes unsigned,
+// w[] <= 127 (here <= 32, so no sum saturates).
+// SSSE3's pshufb and pmaddubsw on x86 (chosen at run time: the functions
+// carrying them are compiled for SSSE3, the rest of the file for the
+// baseline); tbl and umull + addp on AArch64. Elsewhere the portable kernel
+// runs.
+#if defined(__x86_64__) || defined(__i386__)
+STEADIFACE_SHUFFLE_TARGET inline cv::v_uint8x16 ShuffleBytes(
+    const cv::v_uint8x16& a, const cv::v_uint8x16& idx) {
+  return cv::v_uint8x16(_mm_shuffle_epi8(a.val, idx.val));
+}
+STEADIFACE_SHUFFLE_TARGET inline cv::v_int16x8 MulAddPairs(
+    const cv::v_uint8x16& a, const cv::v_uint8x16& w) {
+  return cv::v_int16x8(_mm_maddubs_epi16(a.val, w.val));
+}
+#else  // AArch64
+inline cv::v_uint8x16 ShuffleBytes(const cv::v_uint8x16& a,
+                                   const cv::v_uint8x16& idx) {
+  return cv::v_uint8x16(vqtbl1q_u8(a.val, idx.val));
+}
+inline cv::v_int16x8 MulAddPairs(const cv::v_uint8x16& a,
+                                 const cv::v_uint8x16& w) {
+  const uint16x8_t lo = vmull_u8(vget_low_u8(a.val), vget_low_u8(w.val));
+  const uint16x8_t hi = vmull_high_u8(a.val, w.val);
+  return cv::v_int16x8(vreinterpretq_s16_u16(vpaddq_u16(lo, hi)));
+}
+#endif
+
+// The shuffle kernel, 3 channels, 4 output pixels per step. When the 4
+// pixels read one source row pair (same iy) and at most 4 adjacent source
+// columns (ix0..ix0+3 and their right neighbours: 15 bytes), one 16-byte
+// load per row holds every byte they need, and byte shuffles pick them out;
+// no per-pixel address, no scalar loads. The group's 12 (pixel, channel)
+// samples P = 3 pixel + channel each take a (left, right) byte pair; pairs
+// 0-7 fill register A, 8-11 the low half of register B.
+//   Horizontal step first: per pair left (32 - fx) + right fx, a byte-pair
+//   dot product, <= 255 * 32 (exact in 16 bits).
+//   Vertical step: the rows' sums zipped (top, bottom) and dotted with
+//   64 ((32 - fy), fy), exact in 32 bits (<= 255 * 1024 * 64 < 2^24).
+// The same integer sum h as cv::remap's (and the portable kernel's), times
+// 64: (64 h + 2^15) >> 16 = (h + 512) >> 10, cv::remap's rounding, is byte 2
+// of each 32-bit lane, which a shuffle picks out (no shifts, no packs). The
+// three zipped registers hold P = 0-3, 4-7, 8-11: the output's bytes in
+// order, bit for bit cv::remap's.
+struct Color3ShuffleTables {
+  /// Registers A, B: the byte of each pair's pixel's 32-bit lane (its low
+  /// byte) for both bytes of the pair; 0x80 (zero) past pair 11.
+  alignas(16) uint8_t pair_pixel_byte[2][16];
+  /// Registers A, B: each byte's offset from its pixel's left column:
+  /// channel (left byte), 3 + channel (right byte); 0x80 past pair 11.
+  alignas(16) uint8_t pair_offset[2][16];
+  /// Registers A, B: the two bytes of each pair's pixel's horizontal
+  /// weights ((32 - fx), fx) in its 32-bit lane; 0x80 past pair 11.
+  alignas(16) uint8_t pair_weight_byte[2][16];
+  /// Zipped registers 0-2: each 32-bit lane (pair P = 4r + i) takes its
+  /// pixel's 32-bit lane (the vertical weights).
+  alignas(16) uint8_t pixel_word[3][16];
+  /// Sums 0-2: output byte P = 4r + i is byte 2 of lane i of sum r; 0x80
+  /// (zero) elsewhere, so the three OR into the output.
+  alignas(16) uint8_t output_byte[3][16];
+};
+
+constexpr Color3ShuffleTables MakeColor3ShuffleTables() {
+  Color3ShuffleTables t{};
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < 8; ++k) {
+      const int pair = 8 * r + k, pixel = pair / 3, channel = pair % 3;
+      const bool used = pair < 12;
+      for (int right = 0; right < 2; ++right) {
+        t.pair_pixel_byte[r][2 * k + right] =
+            used ? static_cast<uint8_t>(4 * pixel) : 0x80;
+        t.pair_offset[r][2 * k + right] =
+            used ? static_cast<uint8_t>(3 * right + channel) : 0x80;
+        t.pair_weight_byte[r][2 * k + right] =
+            used ? static_cast<uint8_t>(4 * pixel + right) : 0x80;
+      }
+    }
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int i = 0; i < 4; ++i) {
+      const int pixel = (4 * r + i) / 3;
+      for (int b = 0; b < 4; ++b) {
+        t.pixel_word[r][4 * i + b] = static_cast<uint8_t>(4 * pixel + b);
+      }
+    }
+    for (int b = 0; b < 16; ++b) {
+      t.output_byte[r][b] =
+          b / 4 == r ? static_cast<uint8_t>(4 * (b % 4) + 2) : 0x80;
+    }
+  }
+  return t;
+}
+constexpr Color3ShuffleTables kColor3Shuffle = MakeColor3ShuffleTables();
+
+}  // namespace
+
+#if defined(__x86_64__) || defined(__i386__)
+bool ShuffleSupported() { return cv::checkHardwareSupport(CV_CPU_SSSE3); }
+#else
+bool ShuffleSupported() { return true; }
+#endif
+
+// A stepped 3-channel segment: shuffle groups where they apply, the
+// portable 4-pixel group or scalar pixels elsewhere (same arithmetic).
+STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
+                                                    const cv::Mat& in,
+                                                    int width, uchar* out,
+                                                    SampleStats* counts) {
+  using namespace cv;
+  constexpr int shift = kScanFrac + kInterBits;
+  const uchar* base = in.ptr<uchar>(0);
+  const size_t step = in.step[0];
+  const int n = seg.u1 - seg.u0 + 1;
+  if (n < 4) {
+    SamplePixels(in, 3, seg.X, seg.Y, seg.DX, seg.DY, n, out + seg.u0 * 3);
+    counts->scalar_px += n;
+    return;
+  }
+  // Locals, not seg's fields: the output stores (uchar) may alias seg, so
+  // the compiler would reload them after each one.
+  const int32_t X0 = seg.X, Y0 = seg.Y, DX = seg.DX, DY = seg.DY;
+  const int u0 = seg.u0;
+  const int max_iy = in.rows - 2;
+  // A 16-byte load at pixel ix0 stays in its row for ix0 <= cols - 6.
+  const int max_ix_shuffle = in.cols - 6;
+  const int max_ix_portable = in.cols - 3;
+  // The whole segment within the shuffle's margins and 0 <= DX <= 1 px (so
+  // 4 pixels span at most ix0..ix0+3): only the source row can still differ
+  // within a group, and only that is checked per group.
+  const bool whole = DX >= 0 && DX <= (1 << shift) &&
+                     GroupInside(X0, Y0, DX, DY, n, max_ix_shuffle, max_iy);
+  const v_int32x4 ramp(0, DX, 2 * DX, 3 * DX);
+  const v_int32x4 rampy(0, DY, 2 * DY, 3 * DY);
+  const v_int32x4 dx4 = v_setall_s32(4 * DX), dy4 = v_setall_s32(4 * DY);
+  const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
+  // fy, 64 times, from Y in one shift: Y >> (kScanFrac - 6), masked.
+  const v_int32x4 m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
+  const v_int32x4 k32 = v_setall_s32(kInterTabSize);
+  const v_int32x4 k32x64 = v_setall_s32(kInterTabSize << 6);
+  const v_uint16x8 k255 = v_setall_u16(255);
+  const v_int32x4 half = v_setall_s32(1 << 15);
+  const v_uint8x16 pix_a = v_load(kColor3Shuffle.pair_pixel_byte[0]);
+  const v_uint8x16 pix_b = v_load(kColor3Shuffle.pair_pixel_byte[1]);
+  const v_uint8x16 off_a = v_load(kColor3Shuffle.pair_offset[0]);
+  const v_uint8x16 off_b = v_load(kColor3Shuffle.pair_offset[1]);
+  const v_uint8x16 wsel_a = v_load(kColor3Shuffle.pair_weight_byte[0]);
+  const v_uint8x16 wsel_b = v_load(kColor3Shuffle.pair_weight_byte[1]);
+  const v_uint8x16 word0 = v_load(kColor3Shuffle.pixel_word[0]);
+  const v_uint8x16 word1 = v_load(kColor3Shuffle.pixel_word[1]);
+  const v_uint8x16 word2 = v_load(kColor3Shuffle.pixel_word[2]);
+  const v_uint8x16 out0 = v_load(kColor3Shuffle.output_byte[0]);
+  const v_uint8x16 out1 = v_load(kColor3Shuffle.output_byte[1]);
+  const v_uint8x16 out2 = v_load(kColor3Shuffle.output_byte[2]);
+  int64_t shuffled = 0, portable = 0, scalar = 0;
+  int32_t X = X0, Y = Y0;
+  // The group's 4 coordinates, stepped like X and Y.
+  v_int32x4 Xv = v_setall_s32(X0) + ramp, Yv = v_setall_s32(Y0) + rampy;
+  for (int g = 0; g < n;
+       g += 4, X += 4 * DX, Y += 4 * DY, Xv += dx4, Yv += dy4) {
+    if (g + 4 > n) {  // overlapping last group, as in SampleRow
+      g = n - 4;
+      X = X0 + g * DX;
+      Y = Y0 + g * DY;
+      Xv = v_setall_s32(X) + ramp;
+      Yv = v_setall_s32(Y) + rampy;
+    }
+    const int u = u0 + g;
+    const int ix0 = X >> shift, iy0 = Y >> shift;
+    const int iy3 = (Y + 3 * DY) >> shift;
+    uchar* dst = out + u * 3;
+    if (iy0 != iy3 ||
+        (!whole &&
+         (static_cast<unsigned>(((X + 3 * DX) >> shift) - ix0) > 3u ||
+          ix0 < 0 || ix0 > max_ix_shuffle || iy0 < 0 || iy0 > max_iy))) {
+      if (GroupInside(X, Y, DX, DY, 4, max_ix_portable, max_iy)) {
+        Color4<3>(base, step, Xv, Yv, u + 6 <= width, dst);
+        portable += 4;
+      } else {
+        SamplePixels(in, 3, X, Y, DX, DY, 4, dst);
+        scalar += 4;
+      }
+      continue;
+    }
+    const uchar* p = base + static_cast<size_t>(iy0) * step + ix0 * 3;
+    const v_uint8x16 top = v_load(p);
+    const v_uint8x16 bottom = v_load(p + step);
+    // Each pixel's byte offset from pixel ix0 (0..9), and its weights, one
+    // 32-bit lane per pixel (adds and 16-bit multiplies rather than shifts:
+    // shifts share the shuffles' ports).
+    const v_int32x4 rel = v_shr<shift>(Xv) - v_setall_s32(ix0);
+    const v_uint8x16 off = v_reinterpret_as_u8(rel + rel + rel);
+    const v_int32x4 fx = v_shr<kScanFrac>(Xv) & m31;
+    // Bytes (32 - fx, fx): 32 + 255 fx (fx < 32: the high 16 bits stay 0).
+    const v_uint8x16 wx = v_reinterpret_as_u8(
+        k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fx), k255)));
+    const v_int32x4 fy64 = v_shr<kScanFrac - 6>(Yv) & m31x64;
+    // 16-bit halves (64 (32 - fy), 64 fy).
+    const v_uint8x16 wy =
+        v_reinterpret_as_u8((k32x64 - fy64) | v_shl<16>(fy64));
+    // Horizontal step, per row and pair.
+    const v_uint8x16 idx_a = ShuffleBytes(off, pix_a) + off_a;
+    const v_uint8x16 idx_b = ShuffleBytes(off, pix_b) + off_b;
+    const v_uint8x16 w_a = ShuffleBytes(wx, wsel_a);
+    const v_uint8x16 w_b = ShuffleBytes(wx, wsel_b);
+    const v_int16x8 top_a = MulAddPairs(ShuffleBytes(top, idx_a), w_a);
+    const v_int16x8 top_b = MulAddPairs(ShuffleBytes(top, idx_b), w_b);
+    const v_int16x8 bot_a = MulAddPairs(ShuffleBytes(bottom, idx_a), w_a);
+    const v_int16x8 bot_b = MulAddPairs(ShuffleBytes(bottom, idx_b), w_b);
+    // Vertical step: (top, bottom) per pair, P = 0-3, 4-7, 8-11; rounded,
+    // and the result byte picked out.
+    v_int16x8 z0, z1, z2, unused;
+    v_zip(top_a, bot_a, z0, z1);
+    v_zip(top_b, bot_b, z2, unused);
+    const v_int32x4 h0 =
+        v_dotprod(z0, v_reinterpret_as_s16(ShuffleBytes(wy, word0))) + half;
+    const v_int32x4 h1 =
+        v_dotprod(z1, v_reinterpret_as_s16(ShuffleBytes(wy, word1))) + half;
+    const v_int32x4 h2 =
+        v_dotprod(z2, v_reinterpret_as_s16(ShuffleBytes(wy, word2))) + half;
+    const v_uint8x16 r = ShuffleBytes(v_reinterpret_as_u8(h0), out0) |
+                         ShuffleBytes(v_reinterpret_as_u8(h1), out1) |
+                         ShuffleBytes(v_reinterpret_as_u8(h2), out2);
+    if (u + 6 <= width) {
+      v_store(dst, r);  // bytes 12-15 (zero): the next pixels', written later
+    } else {
+      v_store_low(dst, r);
+      const unsigned tail = v_extract_n<2>(v_reinterpret_as_u32(r));
+      std::memcpy(dst + 8, &tail, 4);
+    }
+    shuffled += 4;
+  }
+  counts->shuffle_px += shuffled;
+  counts->portable_simd_px += portable;
+  counts->scalar_px += scalar;
+}
+// The shuffle kernel, 1 channel, 8 output pixels per step: when the 8 read
+// one source row pair and at most 15 adjacent columns (ix0..ix0+14 and
+// their right neighbours), one 16-byte load per row holds them all. One
+// shuffle per row makes each pixel's (left, right) byte pair, a byte-pair
+// dot product with ((32 - fx), fx) the horizontal step, and the vertical
+// step, the rounding and the byte pick-out are the 3-channel kernel's (the
+// zipped registers hold pixels 0-3 and 4-7, the lanes of the coordinate
+// vectors, so the vertical weights need no shuffle). Bit for bit cv::remap.
+STEADIFACE_SHUFFLE_TARGET void Mono8SegmentShuffle(const ScanSegment& seg,
+                                                   const cv::Mat& in,
+                                                   uchar* out,
+                                                   SampleStats* counts) {
+  using namespace cv;
+  constexpr int shift = kScanFrac + kInterBits;
+  const uchar* base = in.ptr<uchar>(0);
+  const size_t step = in.step[0];
+  const int n = seg.u1 - seg.u0 + 1;
+  if (n < 8) {
+    SamplePixels(in, 1, seg.X, seg.Y, seg.DX, seg.DY, n, out + seg.u0);
+    counts->scalar_px += n;
+    return;
+  }
+  // Locals, not seg's fields (the output stores may alias seg).
+  const int32_t X0 = seg.X, Y0 = seg.Y, DX = seg.DX, DY = seg.DY;
+  const int u0 = seg.u0;
+  const int max_iy = in.rows - 2;
+  // A 16-byte load at pixel ix0 stays in its row for ix0 <= cols - 16.
+  const int max_ix_shuffle = in.cols - 16;
+  // The whole segment within the margins and 0 <= 7 DX <= 14 px: only the
+  // source row is checked per group.
+  const bool whole = DX >= 0 && 7 * static_cast<int64_t>(DX) <= (14 << shift) &&
+                     GroupInside(X0, Y0, DX, DY, n, max_ix_shuffle, max_iy);
+  const v_int32x4 ramp(0, DX, 2 * DX, 3 * DX);
+  const v_int32x4 rampy(0, DY, 2 * DY, 3 * DY);
+  const v_int32x4 dx4 = v_setall_s32(4 * DX), dy4 = v_setall_s32(4 * DY);
+  const v_int32x4 dx8 = v_setall_s32(8 * DX), dy8 = v_setall_s32(8 * DY);
+  const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
+  const v_int32x4 m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
+  const v_int32x4 k32 = v_setall_s32(kInterTabSize);
+  const v_int32x4 k32x64 = v_setall_s32(kInterTabSize << 6);
+  const v_uint16x8 k255 = v_setall_u16(255);
+  const v_int32x4 half = v_setall_s32(1 << 15);
+  // Pixel k's offset (16-bit lane k, < 16) to both bytes of pair k, plus
+  // (0, 1): the left and right columns.
+  alignas(16) static constexpr uint8_t kPairLow[16] = {
+      0, 0, 2, 2, 4, 4, 6, 6, 8, 8, 10, 10, 12, 12, 14, 14};
+  alignas(16) static constexpr uint8_t kLeftRight[16] = {
+      0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1};
+  // Byte 2 of sums 0 and 1's lanes to output bytes 0-3 and 4-7.
+  alignas(16) static constexpr uint8_t kOut0[16] = {
+      2,    6,    10,   14,   0x80, 0x80, 0x80, 0x80,
+      0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
+  alignas(16) static constexpr uint8_t kOut1[16] = {
+      0x80, 0x80, 0x80, 0x80, 2,    6,    10,   14,
+      0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
+  const v_uint8x16 pair_low = v_load(kPairLow);
+  const v_uint8x16 left_right = v_load(kLeftRight);
+  const v_uint8x16 out0 = v_load(kOut0), out1 = v_load(kOut1);
+  int64_t shuffled = 0, portable = 0, scalar = 0;
+  int32_t X = X0, Y = Y0;
+  v_int32x4 Xa = v_setall_s32(X0) + ramp, Ya = v_setall_s32(Y0) + rampy;
+  for (int g = 0; g < n;
+       g += 8, X += 8 * DX, Y += 8 * DY, Xa += dx8, Ya += dy8) {
+    if (g + 8 > n) {  // overlapping last group, as in SampleRow
+      g = n - 8;
+      X = X0 + g * DX;
+      Y = Y0 + g * DY;
+      Xa = v_setall_s32(X) + ramp;
+      Ya = v_setall_s32(Y) + rampy;
+    }
+    const int u = u0 + g;
+    const int ix0 = X >> shift, iy0 = Y >> shift;
+    const int iy7 = (Y + 7 * DY) >> shift;
+    const v_int32x4 Xb = Xa + dx4, Yb = Ya + dy4;
+    if (iy0 != iy7 ||
+        (!whole &&
+         (static_cast<unsigned>(((X + 7 * DX) >> shift) - ix0) > 14u ||
+          ix0 < 0 || ix0 > max_ix_shuffle || iy0 < 0 || iy0 > max_iy))) {
+      if (GroupInside(X, Y, DX, DY, 8, in.cols - 2, max_iy)) {
+        Mono8(base, step, Xa, Xb, Ya, Yb, out + u);
+        portable += 8;
+      } else {
+        SamplePixels(in, 1, X, Y, DX, DY, 8, out + u);
+        scalar += 8;
+      }
+      continue;
+    }
+    const uchar* p = base + static_cast<size_t>(iy0) * step + ix0;
+    const v_uint8x16 top = v_load(p);
+    const v_uint8x16 bottom = v_load(p + step);
+    // Offsets from ix0 (0..14) and horizontal weight bytes (32 - fx, fx)
+    // = 32 + 255 fx, one 16-bit lane per pixel.
+    const v_int32x4 col0 = v_setall_s32(ix0);
+    const v_uint8x16 rel = v_reinterpret_as_u8(
+        v_pack(v_shr<shift>(Xa) - col0, v_shr<shift>(Xb) - col0));
+    const v_int32x4 fxa = v_shr<kScanFrac>(Xa) & m31;
+    const v_int32x4 fxb = v_shr<kScanFrac>(Xb) & m31;
+    const v_uint8x16 wx = v_reinterpret_as_u8(v_pack(
+        k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fxa), k255)),
+        k32 +
+            v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fxb), k255))));
+    const v_uint8x16 idx = ShuffleBytes(rel, pair_low) + left_right;
+    const v_int16x8 t = MulAddPairs(ShuffleBytes(top, idx), wx);
+    const v_int16x8 b = MulAddPairs(ShuffleBytes(bottom, idx), wx);
+    // Vertical step with 64 ((32 - fy), fy) per 32-bit lane (pixel).
+    const v_int32x4 fya = v_shr<kScanFrac - 6>(Ya) & m31x64;
+    const v_int32x4 fyb = v_shr<kScanFrac - 6>(Yb) & m31x64;
+    const v_int16x8 wya = v_reinterpret_as_s16((k32x64 - fya) | v_shl<16>(fya));
+    const v_int16x8 wyb = v_reinterpret_as_s16((k32x64 - fyb) | v_shl<16>(fyb));
+    v_int16x8 z0, z1;
+    v_zip(t, b, z0, z1);
+    const v_int32x4 h0 = v_dotprod(z0, wya) + half;
+    const v_int32x4 h1 = v_dotprod(z1, wyb) + half;
+    v_store_low(out + u, ShuffleBytes(v_reinterpret_as_u8(h0), out0) |
+                             ShuffleBytes(v_reinterpret_as_u8(h1), out1));
+    shuffled += 8;
+  }
+  counts->shuffle_px += shuffled;
+  counts->portable_simd_px += portable;
+  counts->scalar_px += scalar;
+}
+#endif  // STEADIFACE_SHUFFLE_KERNEL
+
+}  // namespace mesh_sampler_internal
+}  // namespace steadiface
