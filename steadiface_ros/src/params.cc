@@ -158,24 +158,24 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   r.Str("world_frame", &wo->world_frame);
   r.Bool("publish_world_tf", &wo->publish_world_tf);
   r.Bool("imu_extrinsics_from_tf", &wo->imu_extrinsics_from_tf);
-  r.Num("max_gyro_wait", &wo->max_gyro_wait_s, 0.0, 5.0);
-  std::string policy = wo->late_frame_policy == LateFramePolicy::kDrop ? "drop" : "extrapolate";
+  r.Num("max_gyro_wait", &wo->scheduler.max_gyro_wait_s, 0.0, 5.0);
+  std::string policy = wo->scheduler.late_frame_policy == steadiface::LateFramePolicy::kDrop ? "drop" : "extrapolate";
   r.Str("late_frame_policy", &policy);
   if (policy == "drop") {
-    wo->late_frame_policy = LateFramePolicy::kDrop;
+    wo->scheduler.late_frame_policy = steadiface::LateFramePolicy::kDrop;
   } else if (policy == "extrapolate") {
-    wo->late_frame_policy = LateFramePolicy::kExtrapolate;
+    wo->scheduler.late_frame_policy = steadiface::LateFramePolicy::kExtrapolate;
   } else {
     r.Error("parameter 'late_frame_policy' must be 'extrapolate' or 'drop', got '" + policy + "'");
   }
-  r.Int("frame_queue_size", &wo->frame_queue_size, 1, 1000);
-  r.Num("imu_timeout", &wo->imu_timeout_s, 0.01, 60.0);
-  r.Num("imu_gap_warn", &wo->imu_gap_warn_s, 0.001, 10.0);
+  r.Int("frame_queue_size", &wo->scheduler.frame_queue_size, 1, 1000);
+  r.Num("imu_timeout", &wo->scheduler.imu_timeout_s, 0.01, 60.0);
+  r.Num("imu_gap_warn", &wo->scheduler.imu_gap_warn_s, 0.001, 10.0);
   r.Num("expected_image_rate", &wo->expected_image_rate, 0.0, 1000.0);
   r.Num("expected_imu_rate", &wo->expected_imu_rate, 0.0, 100000.0);
   r.Bool("passthrough_without_imu", &wo->passthrough_without_imu);
   r.Bool("pipelined", &wo->pipelined);
-  r.Num("pipeline_hold", &wo->pipeline_hold_s, 0.0, 1.0);
+  r.Num("pipeline_hold", &wo->scheduler.pipeline_hold_s, 0.0, 1.0);
   std::string source = po->landmark_source == LandmarkSource::kExternal
                            ? "topic"
                            : po->landmark_source == LandmarkSource::kNone ? "none" : "dlib";

@@ -285,9 +285,9 @@ void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
               steadiface::SampleResultName(static_cast<steadiface::SampleResult>(i)),
           w.timeline.samples[i]);
   }
-  if (!imu_seen_ && since > wrapper_options_.imu_timeout_s) {
+  if (!imu_seen_ && since > wrapper_options_.scheduler.imu_timeout_s) {
     s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no IMU data: frames are not stabilized");
-  } else if (since > wrapper_options_.imu_timeout_s) {
+  } else if (since > wrapper_options_.scheduler.imu_timeout_s) {
     s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "IMU stopped");
   } else if (w.counters.imu_rejected > 0 || w.counters.imu_gaps > 0 || w.counters.extrapolated > 0) {
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN,

@@ -1,5 +1,7 @@
 #include "steadiface_ros/stabilizer_wrapper.h"
 
+#include <optional>
+
 #include <sensor_msgs/image_encodings.h>
 
 #include "steadiface_core/warp/debug_overlay.h"
@@ -9,8 +11,12 @@
 namespace steadiface_ros {
 namespace {
 
-// A backwards step larger than this is a new epoch (bag loop, /clock reset).
-constexpr double kTimeJumpS = 1.0;
+// The receive clock as the scheduler takes it: zero means none (the IMU
+// callback, end of input), so no wait runs out.
+std::optional<steadiface::Time> ReceiveTime(const ros::Time& now) {
+  if (now.isZero()) return std::nullopt;
+  return ToCoreTime(now);
+}
 
 bool SameGeometry(const sensor_msgs::CameraInfo& a, const sensor_msgs::CameraInfo& b) {
   return a.width == b.width && a.height == b.height && a.K == b.K && a.D == b.D &&
@@ -28,7 +34,8 @@ StabilizerWrapper::StabilizerWrapper(const steadiface::PipelineOptions& pipeline
     : options_(pipeline),
       wrapper_options_(options),
       sink_(sink),
-      extrinsic_lookup_(std::move(extrinsic_lookup)) {
+      extrinsic_lookup_(std::move(extrinsic_lookup)),
+      scheduler_(options.scheduler) {
   // Load the ~100 MB landmark model now, not on the first frame (which
   // would stall the image queue for a second).
   if (options_.landmark_source != steadiface::LandmarkSource::kNone) {
@@ -113,11 +120,8 @@ void StabilizerWrapper::ResetAll(const char* why) {
                                "): resetting gyro timeline, face tracker and stabilizer");
   FinishHeld();  // the last frame of the old epoch
   if (pipeline_) pipeline_->Reset();
-  recent_gyro_.clear();
-  queue_.clear();
-  last_frame_stamp_ = ros::Time();
+  scheduler_.Reset();
   last_tf_stamp_ = ros::Time();
-  have_last_imu_ = false;
   frusta_.Clear();
   sink_->OnTimeJump();
 }
@@ -125,15 +129,12 @@ void StabilizerWrapper::ResetAll(const char* why) {
 void StabilizerWrapper::OnImu(const sensor_msgs::Imu& msg) {
   ++counters_.imu_in;
   if (imu_frame_.empty()) imu_frame_ = msg.header.frame_id;
-  if (have_last_imu_ && msg.header.stamp + ros::Duration(kTimeJumpS) < last_imu_stamp_) {
-    ResetAll("IMU stamp");
-  }
-  if (have_last_imu_ && msg.header.stamp > last_imu_stamp_ &&
-      (msg.header.stamp - last_imu_stamp_).toSec() > wrapper_options_.imu_gap_warn_s) {
+  const steadiface::Time stamp = ToCoreTime(msg.header.stamp);
+  if (scheduler_.IsGyroTimeJump(stamp)) ResetAll("IMU stamp");
+  const double gap_s = scheduler_.GyroGap(stamp);
+  if (gap_s > 0.0) {
     ++counters_.imu_gaps;
-    sink_->Warn("imu_gap", "IMU gap of " +
-                               std::to_string((msg.header.stamp - last_imu_stamp_).toSec()) +
-                               " s");
+    sink_->Warn("imu_gap", "IMU gap of " + std::to_string(gap_s) + " s");
   }
   const steadiface::GyroSample g = ToGyroSample(msg);
   steadiface::SampleResult r = steadiface::SampleResult::kAccepted;
@@ -148,18 +149,9 @@ void StabilizerWrapper::OnImu(const sensor_msgs::Imu& msg) {
                 std::string("IMU sample rejected: ") + steadiface::SampleResultName(r));
     return;
   }
-  if (!have_last_imu_ || msg.header.stamp > last_imu_stamp_) {
-    last_imu_stamp_ = msg.header.stamp;
-    have_last_imu_ = true;
-  }
-  // Keep a bounded copy for rebuilding the pipeline (geometry change).
-  recent_gyro_.push_back(g);
-  const steadiface::Duration keep = steadiface::FromSeconds(options_.imu.buffer_duration_s);
-  while (!recent_gyro_.empty() &&
-         (recent_gyro_.back().stamp - recent_gyro_.front().stamp > keep ||
-          recent_gyro_.size() > static_cast<size_t>(options_.imu.max_samples))) {
-    recent_gyro_.pop_front();
-  }
+  // The scheduler keeps a bounded copy for rebuilding the pipeline.
+  scheduler_.OnGyroAccepted(g, steadiface::FromSeconds(options_.imu.buffer_duration_s),
+                            static_cast<size_t>(options_.imu.max_samples));
   // Frames the gyro now covers; waits run out in OnTimer / OnImage.
   Drain(ros::Time(), false);
 }
@@ -211,10 +203,10 @@ bool StabilizerWrapper::EnsurePipeline(const sensor_msgs::CameraInfo& info,
     return false;
   }
   if (pipeline_) ++counters_.rebuilds;
-  for (const auto& g : recent_gyro_) p->AddGyro(g);
+  for (const auto& g : scheduler_.recent_gyro()) p->AddGyro(g);
   pipeline_ = std::move(p);
   pipeline_info_ = info;
-  last_frame_stamp_ = ros::Time();
+  scheduler_.ForgetLastFrame();
   return true;
 }
 
@@ -227,22 +219,19 @@ void StabilizerWrapper::OnImage(const sensor_msgs::ImageConstPtr& image,
     sink_->Error("camera_info", "image without camera_info");
     return;
   }
-  if (!last_frame_stamp_.isZero() &&
-      image->header.stamp + ros::Duration(kTimeJumpS) < last_frame_stamp_) {
-    ResetAll("image stamp");
-  }
-  const ros::Time newest_queued = queue_.empty() ? last_frame_stamp_ : queue_.back().image->header.stamp;
-  if (!newest_queued.isZero() && image->header.stamp <= newest_queued) {
+  const steadiface::Time stamp = ToCoreTime(image->header.stamp);
+  if (scheduler_.IsFrameTimeJump(stamp)) ResetAll("image stamp");
+  using Admission = steadiface::FrameScheduler<Pending>::Admission;
+  const Admission a = scheduler_.Admit({image, info, now}, stamp, ToCoreTime(now));
+  if (a == Admission::kOldStamp) {
     ++counters_.dropped_old_stamp;
     sink_->Warn("old_stamp", "image stamp not after the previous frame's: dropped");
     return;
   }
-  if (queue_.size() >= static_cast<size_t>(wrapper_options_.frame_queue_size)) {
+  if (a == Admission::kQueuedDroppedOldest) {
     ++counters_.dropped_queue_full;
     sink_->Warn("queue_full", "frame queue full (gyro too slow?): dropping the oldest frame");
-    queue_.pop_front();
   }
-  queue_.push_back({image, info, now});
   Drain(now, false);
 }
 
@@ -254,32 +243,23 @@ void StabilizerWrapper::Flush() {
 }
 
 void StabilizerWrapper::Drain(const ros::Time& now, bool flush) {
-  while (!queue_.empty()) {
-    const Pending& p = queue_.front();
+  const std::optional<steadiface::Time> at = ReceiveTime(now);
+  while (const auto* q = scheduler_.Front()) {
+    const Pending& p = q->frame;
     const std::string frame_id = wrapper_options_.camera_frame.empty()
                                      ? p.image->header.frame_id
                                      : wrapper_options_.camera_frame;
     if (!EnsurePipeline(*p.info, frame_id)) {
-      queue_.pop_front();
+      scheduler_.DropFront();
       continue;
     }
-    const steadiface::Time stamp = ToCoreTime(p.image->header.stamp);
-    const bool covered = pipeline_->GyroCovers(stamp);
-    const bool waited_out =
-        flush || (!now.isZero() && now >= p.received &&
-                  (now - p.received).toSec() >= wrapper_options_.max_gyro_wait_s);
-    if (!covered && !waited_out) break;  // keep waiting (FIFO: later frames too)
-    const Pending item = p;
-    queue_.pop_front();
-    Process(item, !covered);
+    auto released = scheduler_.ReleaseFront(pipeline_->GyroCovers(q->stamp), at, flush);
+    if (!released) break;  // keep waiting (FIFO: later frames too)
+    Process(released->queued.frame, released->late);
   }
   // pipelined: a processed frame waits for the next one at most
   // pipeline_hold (and not at all at the end of input).
-  if (held_ && (flush || (!now.isZero() && now >= held_->p.received &&
-                          (now - held_->p.received).toSec() >=
-                              wrapper_options_.pipeline_hold_s))) {
-    FinishHeld();
-  }
+  if (held_ && scheduler_.HoldRanOut(ToCoreTime(held_->p.received), at, flush)) FinishHeld();
 }
 
 void StabilizerWrapper::Process(const Pending& p, bool late) {
@@ -290,23 +270,18 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   cv::Mat image;
   if (!ToCheckedImage(p, &image)) return;
   const steadiface::Time stamp = ToCoreTime(p.image->header.stamp);
-  const bool imu_dead =
-      !have_last_imu_ ||
-      (p.image->header.stamp - last_imu_stamp_).toSec() > wrapper_options_.imu_timeout_s;
-  if (imu_dead) {
+  const steadiface::FrameDisposition d = scheduler_.Dispose(stamp, late);
+  if (d == steadiface::FrameDisposition::kNoImu) {
     PublishPassthrough(p, image, started);
     return;
   }
-  steadiface::PipelineFrame frame;
-  bool extrapolated = false;
-  if (late) {
-    if (wrapper_options_.late_frame_policy == LateFramePolicy::kDrop) {
-      ++counters_.dropped_no_gyro;
-      sink_->Warn("late_frame", "gyro did not cover the frame within max_gyro_wait: dropped");
-      return;
-    }
-    extrapolated = true;
+  if (d == steadiface::FrameDisposition::kDropLate) {
+    ++counters_.dropped_no_gyro;
+    sink_->Warn("late_frame", "gyro did not cover the frame within max_gyro_wait: dropped");
+    return;
   }
+  steadiface::PipelineFrame frame;
+  const bool extrapolated = d == steadiface::FrameDisposition::kExtrapolate;
   const bool use_external =
       options_.landmark_source == steadiface::LandmarkSource::kExternal;
   // External landmarks count only for the image they were made for.
@@ -327,7 +302,7 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
     return;
   }
   if (extrapolated) ++counters_.extrapolated;
-  last_frame_stamp_ = p.image->header.stamp;
+  scheduler_.OnFrameDone(stamp);
   if (!pipelined) {
     Publish(p, frame, image, extrapolated, false, started);
     return;
@@ -379,7 +354,7 @@ void StabilizerWrapper::PublishPassthrough(const Pending& p, const cv::Mat& imag
   }
   ++counters_.passthrough;
   sink_->Error("no_imu", "no IMU data: publishing unstabilized frames");
-  last_frame_stamp_ = p.image->header.stamp;
+  scheduler_.OnFrameDone(ToCoreTime(p.image->header.stamp));
   FinishHeld();  // in order
   Publish(p, frame, image, false, true, started);
 }
@@ -541,11 +516,10 @@ void StabilizerWrapper::UpdateStatus(const steadiface::PipelineFrame& frame,
   status_.last_solver_termination = frame.stabilizer.solver.termination;
   status_.last_solver_ms = frame.stabilizer.solver.time_ms;
   status_.last_solver_iterations = frame.stabilizer.solver.iterations;
-  if (have_last_imu_) {
-    status_.gyro_latency_s =
-        (last_imu_stamp_ - in_header.stamp).toSec() -
-        steadiface::ToSeconds(pipeline_->LastRowTime(ToCoreTime(in_header.stamp)) -
-                              ToCoreTime(in_header.stamp));
+  if (scheduler_.have_gyro()) {
+    const steadiface::Time stamp = ToCoreTime(in_header.stamp);
+    status_.gyro_latency_s = (ToRosTime(scheduler_.last_gyro_stamp()) - in_header.stamp).toSec() -
+                             steadiface::ToSeconds(pipeline_->LastRowTime(stamp) - stamp);
   }
 }
 
@@ -553,7 +527,7 @@ WrapperStatus StabilizerWrapper::Status() const {
   WrapperStatus s = status_;
   s.counters = counters_;
   s.pipeline_ready = pipeline_ != nullptr;
-  s.imu_ever = have_last_imu_;
+  s.imu_ever = scheduler_.have_gyro();
   if (pipeline_) {
     s.timeline = pipeline_->timeline().stats();
     s.stabilizer = pipeline_->stabilizer().stats();

@@ -414,10 +414,10 @@ TEST(WrapperTest, ImuFaultsAreRejectedCountedAndHarmless) {
 }
 
 TEST(WrapperTest, ImuGapIsWarnedAndFramesExtrapolatedOrDropped) {
-  for (LateFramePolicy policy : {LateFramePolicy::kExtrapolate, LateFramePolicy::kDrop}) {
+  for (steadiface::LateFramePolicy policy : {steadiface::LateFramePolicy::kExtrapolate, steadiface::LateFramePolicy::kDrop}) {
     Sink sink;
     WrapperOptions wo;
-    wo.late_frame_policy = policy;
+    wo.scheduler.late_frame_policy = policy;
     steadiface::PipelineOptions po = Options();
     po.imu.max_extrapolation_s = 0.05;
     StabilizerWrapper w(po, wo, &sink);
@@ -428,7 +428,7 @@ TEST(WrapperTest, ImuGapIsWarnedAndFramesExtrapolatedOrDropped) {
     });
     const WrapperStatus s = w.Status();
     EXPECT_GT(s.counters.imu_gaps, 0u);
-    if (policy == LateFramePolicy::kExtrapolate) {
+    if (policy == steadiface::LateFramePolicy::kExtrapolate) {
       EXPECT_GT(s.counters.extrapolated + s.counters.dropped_no_gyro, 0u);
     } else {
       EXPECT_GT(s.counters.dropped_no_gyro, 0u);
@@ -539,7 +539,7 @@ TEST(WrapperTest, CameraInfoMissingOrChangingIsHandled) {
 TEST(WrapperTest, BurstsBeyondTheQueueAreBoundedAndCounted) {
   Sink sink;
   WrapperOptions wo;
-  wo.frame_queue_size = 5;
+  wo.scheduler.frame_queue_size = 5;
   StabilizerWrapper w(Options(), wo, &sink);
   const Stream& st = TestStream();
   // A burst of 30 frames before any IMU arrives, and no time passing.

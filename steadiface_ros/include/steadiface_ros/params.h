@@ -8,6 +8,7 @@
 
 #include "steadiface/SteadifaceConfig.h"
 #include "steadiface_core/common/status.h"
+#include "steadiface_core/pipeline/frame_scheduler.h"
 #include "steadiface_core/pipeline/pipeline.h"
 
 namespace steadiface_ros {
@@ -32,13 +33,6 @@ std::unique_ptr<ParamSource> RosParams(const ros::NodeHandle& private_nh);
 steadiface::Status YamlParams(const std::vector<std::string>& paths,
                               std::unique_ptr<ParamSource>* out);
 
-/// What to do with a frame whose last row the gyro has not covered within
-/// max_gyro_wait.
-enum class LateFramePolicy {
-  kExtrapolate,  ///< process with the gyro extrapolated (bounded by imu/max_extrapolation)
-  kDrop,         ///< drop and count it
-};
-
 /// ROS-layer options (the core's are in PipelineOptions).
 struct WrapperOptions {
   /// Frame of the published stabilized image; empty = input frame + suffix.
@@ -53,16 +47,12 @@ struct WrapperOptions {
   bool publish_world_tf = true;
   /// Look up the IMU -> camera rotation in TF when the IMU frame differs.
   bool imu_extrinsics_from_tf = true;
-  /// Max wait for gyro coverage of a frame's last row [s].
-  double max_gyro_wait_s = 0.1;
-  LateFramePolicy late_frame_policy = LateFramePolicy::kExtrapolate;
-  /// Frames waiting for gyro [count]; older ones are dropped when full.
-  int frame_queue_size = 10;
-  /// No IMU message for this long -> ERROR diagnostic, frames pass through
-  /// unstabilized [s].
-  double imu_timeout_s = 1.0;
-  /// IMU gap that raises a WARN [s].
-  double imu_gap_warn_s = 0.05;
+  /// The stream's rules: the wait for gyro coverage, the late-frame
+  /// policy, the frame queue, the IMU timeout and gap warning, the pipelined
+  /// hold (keys max_gyro_wait, late_frame_policy, frame_queue_size,
+  /// imu_timeout, imu_gap_warn, pipeline_hold). No IMU for imu_timeout also
+  /// raises the ERROR diagnostic.
+  steadiface::FrameSchedulerOptions scheduler;
   /// Expected rates for the FrequencyStatus diagnostics [Hz] (0 = any).
   double expected_image_rate = 0.0;
   double expected_imu_rate = 0.0;
@@ -72,12 +62,10 @@ struct WrapperOptions {
   /// n+1 goes through face, check and stabilizer; frame n is published
   /// when frame n+1 is done (or after pipeline_hold, or at the end). Uses a
   /// second core; adds up to one frame of latency. The bag tool turns it on.
+  /// (scheduler.pipeline_hold_s: the next frame is processed about a frame
+  /// period plus the readout and the gyro's delay later: a shorter hold
+  /// overlaps frames only when they queue up, i.e. the node falls behind.)
   bool pipelined = false;
-  /// The longest a processed frame waits for the next one before it is
-  /// published anyway (pipelined) [s]. The next frame is processed about a
-  /// frame period plus the readout and the gyro's delay later: a shorter
-  /// hold overlaps frames only when they queue up (the node falls behind).
-  double pipeline_hold_s = 0.1;
 };
 
 /// Loads every option, validating each; errors name the key and its valid

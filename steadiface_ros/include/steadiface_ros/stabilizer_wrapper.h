@@ -17,6 +17,7 @@
 
 #include "steadiface/FaceLandmarks.h"
 #include "steadiface/StabilizerState.h"
+#include "steadiface_core/pipeline/frame_scheduler.h"
 #include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_ros/frusta_markers.h"
 #include "steadiface_ros/params.h"
@@ -108,9 +109,10 @@ struct WrapperStatus {
 };
 
 /// The one object behind the nodelet, the node and the offline bag tool: it
-/// converts messages, buffers IMU continuously, queues frames until the
-/// gyro covers their last row (bounded wait), runs the core Pipeline and
-/// hands the results to an OutputSink.
+/// converts messages, hands IMU samples and frames to the core's
+/// FrameScheduler (which holds the stream's rules: gyro coverage, the
+/// late-frame policy, time jumps, bounded queues), runs the core Pipeline
+/// on the frames it releases and hands the results to an OutputSink.
 ///
 /// Threading: OnImu / OnImage / OnLandmarks / OnTimer / Flush must be
 /// serialized by the owner (the nodelet runs them on one callback queue).
@@ -159,7 +161,7 @@ class StabilizerWrapper {
     ros::Time received;
   };
   void Drain(const ros::Time& now, bool flush);
-  void Process(const Pending& p, bool allow_extrapolation);
+  void Process(const Pending& p, bool late);
   bool EnsurePipeline(const sensor_msgs::CameraInfo& info, const std::string& frame_id);
   void ResetAll(const char* why);
   void ApplyPendingOptions();
@@ -202,16 +204,13 @@ class StabilizerWrapper {
   sensor_msgs::CameraInfo pipeline_info_;
   std::string imu_frame_;
   bool extrinsic_resolved_ = false;
-  std::deque<steadiface::GyroSample> recent_gyro_;  // bounded, for rebuilds
-  std::deque<Pending> queue_;                       // bounded by frame_queue_size
-  FrustaMarkers frusta_;                            // bounded trails
+  // Frames waiting for the gyro and the recent gyro for rebuilds (bounded).
+  steadiface::FrameScheduler<Pending> scheduler_;
+  FrustaMarkers frusta_;  // bounded trails
   std::vector<Eigen::Vector2d> external_landmarks_;
   double external_confidence_ = 0.0;
   ros::Time last_external_stamp_;
-  ros::Time last_frame_stamp_;
   ros::Time last_tf_stamp_;
-  ros::Time last_imu_stamp_;
-  bool have_last_imu_ = false;
   WrapperCounters counters_;
   WrapperStatus status_;
 

@@ -190,7 +190,7 @@ int main(int argc, char** argv) {
   // Offline, throughput counts and latency does not: render each frame on
   // a second thread while the next one is processed (same output).
   wo.pipelined = !a.no_pipeline;
-  wo.pipeline_hold_s = 1.0;  // bag time: the next frame's gyro comes later
+  wo.scheduler.pipeline_hold_s = 1.0;  // bag time: the next frame's gyro comes later
   if (a.gyro_only) {
     po.stabilizer.gyro_only = true;
     po.landmark_source = steadiface::LandmarkSource::kNone;
