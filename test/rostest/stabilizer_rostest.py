@@ -3,8 +3,9 @@
 --clock). Checks: stabilized images and a consistent camera_info, finite and
 strictly increasing TF, lower head jitter than the input (ground truth from
 the simulator's CSV sidecar), a reconfigure of w_fit reaching the state
-topic, and the documented diagnostics. With --no-imu: ERROR diagnostic
-within 2 s and unstabilized frames still published."""
+topic, and the documented diagnostics, one test method each. With
+--no-imu: ERROR diagnostic within 2 s and unstabilized frames still
+published; --layered, --equivalence and --bag-loop run their own cases."""
 import argparse
 import csv
 import math
@@ -119,8 +120,111 @@ def BagToolParams():
     return [a for f in ARGS.params for a in ("--params", f)]
 
 
+class NoImuTest(unittest.TestCase):
+    """Without IMU: unstabilized frames still published, ERROR within 2 s."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.c = Collector(watch_input=True)
+
+    def test_1_frames_pass_through(self):
+        self.assertTrue(wait_for(lambda: len(self.c.images) > 0, 40), "no image published without IMU")
+
+    def test_2_gyro_error_within_2_s(self):
+        c = self.c
+        self.assertTrue(wait_for(lambda: len(c.images) > 0, 40), "no image published without IMU")
+        t0 = time.time()
+        name = ARGS.node.lstrip("/") + ": gyro"
+        ok = wait_for(lambda: name in c.diag and c.diag[name][0] == DiagnosticStatus.ERROR, 2.5)
+        self.assertTrue(ok, "no ERROR on '%s' within 2 s of the first frame: %s" % (name, c.diag.get(name)))
+        self.assertLess(time.time() - t0, 2.6)
+
+
 class StabilizerTest(unittest.TestCase):
-    def check_bag_loop(self, c):
+    """The node or nodelet on the walk bag, one method per behaviour. They
+    share one playback and run in their numbered order: the reconfigure,
+    which changes what follows, comes last; the head jitter is measured on
+    the frames before it."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.c = Collector(watch_input=True)
+        cls.started = wait_for(lambda: len(cls.c.states) >= 70, 60)
+        with cls.c.lock:
+            cls.imgs, cls.infos = list(cls.c.images), list(cls.c.infos)
+            cls.states = list(cls.c.states)
+
+    def setUp(self):
+        self.assertTrue(self.started, "fewer than 70 frames stabilized")
+
+    def test_1_camera_info_matches_the_image(self):
+        self.assertGreater(len(self.imgs), 30)
+        for (stamp, w, h), info in zip(self.imgs, self.infos):
+            self.assertEqual((w, h), (info.width, info.height))
+            self.assertTrue(all(math.isfinite(v) for v in info.K))
+            self.assertGreater(info.K[0], 0)
+
+    def test_2_tf_is_finite_and_strictly_increasing(self):
+        with self.c.lock:
+            tf = [t for t in self.c.tf if t.child_frame_id.endswith("_stabilized")]
+        self.assertGreater(len(tf), 30)
+        stamps = [t.header.stamp.to_sec() for t in tf]
+        self.assertTrue(all(b > a for a, b in zip(stamps, stamps[1:])), "TF stamps not increasing")
+        for t in tf:
+            q = t.transform.rotation
+            self.assertTrue(all(math.isfinite(v) for v in (q.x, q.y, q.z, q.w)))
+            self.assertAlmostEqual(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w, 1.0, places=6)
+
+    def test_3_head_jitter_is_below_half_the_input(self):
+        # Ground truth from the simulator's sidecar.
+        truth = {}
+        with open(ARGS.truth) as f:
+            for r in csv.DictReader(f):
+                truth[round(float(r["stamp"]), 3)] = (float(r["head_x"]), float(r["head_y"]), r["head_in_view"] == "1")
+        K_in = np.array(self.c.in_info.K).reshape(3, 3)
+        head_in, head_out = [], []
+        info_by_stamp = {round(i.header.stamp.to_sec(), 3): i for i in self.infos}
+        for s in self.states:
+            key = round(s.header.stamp.to_sec(), 3)
+            if key not in truth or key not in info_by_stamp or not truth[key][2]:
+                continue
+            p = np.array([truth[key][0], truth[key][1], 1.0])
+            K_out = np.array(info_by_stamp[key].K).reshape(3, 3)
+            R = quat_to_R(s.virtual_rotation).dot(quat_to_R(s.real_rotation).T)
+            q = K_out.dot(R.dot(np.linalg.solve(K_in, p)))
+            head_in.append(p[:2])
+            head_out.append(q[:2] / q[2])
+        self.assertGreater(len(head_in), 30)
+        j_in, j_out = highpass_rms(head_in, 30.0), highpass_rms(head_out, 30.0)
+        rospy.loginfo("head jitter: input %.2f px, output %.2f px", j_in, j_out)
+        print("head jitter: input %.2f px, output %.2f px" % (j_in, j_out))
+        self.assertLess(j_out, 0.5 * j_in)
+
+    def test_4_diagnostics_have_the_documented_keys(self):
+        c, dnode = self.c, ARGS.node.lstrip("/")  # diagnostic_updater drops the leading '/'
+        ok = wait_for(lambda: all((dnode + ": " + k) in c.diag for k in KEYS), 10)
+        self.assertTrue(ok, "missing diagnostics: %s" % sorted(c.diag.keys()))
+        self.assertNotEqual(c.diag[dnode + ": gyro"][0], DiagnosticStatus.ERROR)
+        self.assertEqual(c.diag[dnode + ": face"][0], DiagnosticStatus.OK, c.diag[dnode + ": face"])
+
+    def test_5_reconfigure_reaches_the_state_topic(self):
+        # w_fit to 0 reaches the state topic within a few frames.
+        c = self.c
+        import dynamic_reconfigure.client
+        client = dynamic_reconfigure.client.Client(ARGS.node, timeout=10)
+        with c.lock:
+            n_before = len(c.states)
+        client.update_configuration({"w_fit": 0.0})
+        ok = wait_for(lambda: any(s.w_fit == 0.0 and not s.face_used for s in c.states[n_before:]), 20)
+        self.assertTrue(ok, "w_fit = 0 did not show in the state topic")
+        with c.lock:
+            first_zero = next(i for i in range(n_before, len(c.states)) if c.states[i].w_fit == 0.0)
+        self.assertLessEqual(first_zero - n_before, 10, "reconfigure took more than 10 frames")
+
+
+class BagLoopTest(unittest.TestCase):
+    def test_second_pass_matches_a_fresh_start(self):
+        c = Collector(watch_input=False)
         # rosbag play --loop --clock: /clock and every stamp jump back at the
         # loop. After the reset, the second pass must reproduce a fresh start:
         # the offline tool on the whole bag (itself equal to the live nodelet,
@@ -182,7 +286,11 @@ class StabilizerTest(unittest.TestCase):
         self.assertGreaterEqual(backs, 1)
         self.assertLessEqual(backs, len(p))
 
-    def check_equivalence(self, c):
+
+
+class EquivalenceTest(unittest.TestCase):
+    def test_live_poses_match_the_offline_tool(self):
+        c = Collector(watch_input=False)
         # The live nodelet and steadiface_bag on the same bag: same poses.
         import os
         import subprocess
@@ -244,11 +352,20 @@ class StabilizerTest(unittest.TestCase):
         self.assertLess(worst_angle, 1e-6)
         self.assertLess(worst_t, 1e-6)
 
-    def check_layered(self, c, node):
-        """warp/mode layered on the live node: both virtual cameras in TF, the
-        layer figures in `state`, an output image per state, and a
-        dynamic_reconfigure switch back to global within a few frames."""
-        self.assertTrue(wait_for(lambda: len(c.states) >= 40, 60), "fewer than 40 frames stabilized")
+
+class LayeredTest(unittest.TestCase):
+    """warp/mode layered on the live node: both virtual cameras in TF, the
+    layer figures in `state`, an output image per state, and a
+    dynamic_reconfigure switch back to global within a few frames."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.c = Collector(watch_input=True)
+        cls.started = wait_for(lambda: len(cls.c.states) >= 40, 60)
+
+    def test_1_both_layers_in_tf_state_and_images(self):
+        c = self.c
+        self.assertTrue(self.started, "fewer than 40 frames stabilized")
         with c.lock:
             states = list(c.states)
             tf = list(c.tf)
@@ -270,8 +387,12 @@ class StabilizerTest(unittest.TestCase):
             self.assertTrue(all(math.isfinite(v) for v in info.K))
         print("layered: %d states, blend > 0.5 on %d, worst cell %.3f, largest blend step %.4f" % (
             len(states), len(blended), min(s.min_cell_ratio for s in states), max(steps)))
+
+    def test_2_reconfigure_switches_back_to_global(self):
+        c = self.c
+        self.assertTrue(self.started, "fewer than 40 frames stabilized")
         import dynamic_reconfigure.client
-        client = dynamic_reconfigure.client.Client(node, timeout=10)
+        client = dynamic_reconfigure.client.Client(ARGS.node, timeout=10)
         with c.lock:
             n_before = len(c.states)
         client.update_configuration({"warp_mode": "global"})
@@ -280,89 +401,6 @@ class StabilizerTest(unittest.TestCase):
         with c.lock:
             first = next(i for i in range(n_before, len(c.states)) if c.states[i].warp_mode == "global")
         self.assertLessEqual(first - n_before, 10, "the mode switch took more than 10 frames")
-
-    def test_stabilizer(self):
-        c = Collector(watch_input=not (ARGS.equivalence or ARGS.bag_loop))
-        node = ARGS.node
-        dnode = node.lstrip("/")  # diagnostic_updater names drop the leading '/'
-        if ARGS.layered:
-            self.check_layered(c, node)
-            return
-        if ARGS.equivalence:
-            self.check_equivalence(c)
-            return
-        if ARGS.bag_loop:
-            self.check_bag_loop(c)
-            return
-        if ARGS.no_imu:
-            self.assertTrue(wait_for(lambda: len(c.images) > 0, 40), "no image published without IMU")
-            t0 = time.time()
-            name = dnode + ": gyro"
-            ok = wait_for(lambda: name in c.diag and c.diag[name][0] == DiagnosticStatus.ERROR, 2.5)
-            self.assertTrue(ok, "no ERROR on '%s' within 2 s of the first frame: %s" % (name, c.diag.get(name)))
-            self.assertLess(time.time() - t0, 2.6)
-            return
-
-        self.assertTrue(wait_for(lambda: len(c.states) >= 70, 60), "fewer than 70 frames stabilized")
-        # camera_info consistent with the output.
-        with c.lock:
-            imgs, infos = list(c.images), list(c.infos)
-        self.assertGreater(len(imgs), 30)
-        for (stamp, w, h), info in zip(imgs, infos):
-            self.assertEqual((w, h), (info.width, info.height))
-            self.assertTrue(all(math.isfinite(v) for v in info.K))
-            self.assertGreater(info.K[0], 0)
-        # Reconfigure: w_fit to 0 reaches the state topic within a few frames.
-        import dynamic_reconfigure.client
-        client = dynamic_reconfigure.client.Client(node, timeout=10)
-        with c.lock:
-            n_before = len(c.states)
-        client.update_configuration({"w_fit": 0.0})
-        ok = wait_for(lambda: any(s.w_fit == 0.0 and not s.face_used for s in c.states[n_before:]), 20)
-        self.assertTrue(ok, "w_fit = 0 did not show in the state topic")
-        with c.lock:
-            first_zero = next(i for i in range(n_before, len(c.states)) if c.states[i].w_fit == 0.0)
-        self.assertLessEqual(first_zero - n_before, 10, "reconfigure took more than 10 frames")
-        # Diagnostics with the documented keys.
-        ok = wait_for(lambda: all((dnode + ": " + k) in c.diag for k in KEYS), 10)
-        self.assertTrue(ok, "missing diagnostics: %s" % sorted(c.diag.keys()))
-        self.assertNotEqual(c.diag[dnode + ": gyro"][0], DiagnosticStatus.ERROR)
-        self.assertEqual(c.diag[dnode + ": face"][0], DiagnosticStatus.OK, c.diag[dnode + ": face"])
-        # TF finite and strictly increasing.
-        with c.lock:
-            tf = [t for t in c.tf if t.child_frame_id.endswith("_stabilized")]
-        self.assertGreater(len(tf), 30)
-        stamps = [t.header.stamp.to_sec() for t in tf]
-        self.assertTrue(all(b > a for a, b in zip(stamps, stamps[1:])), "TF stamps not increasing")
-        for t in tf:
-            q = t.transform.rotation
-            self.assertTrue(all(math.isfinite(v) for v in (q.x, q.y, q.z, q.w)))
-            self.assertAlmostEqual(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w, 1.0, places=6)
-        # Head jitter from ground truth, on the frames before the reconfigure.
-        truth = {}
-        with open(ARGS.truth) as f:
-            for r in csv.DictReader(f):
-                truth[round(float(r["stamp"]), 3)] = (float(r["head_x"]), float(r["head_y"]), r["head_in_view"] == "1")
-        K_in = np.array(c.in_info.K).reshape(3, 3)
-        head_in, head_out = [], []
-        info_by_stamp = {round(i.header.stamp.to_sec(), 3): i for i in infos}
-        with c.lock:
-            states = list(c.states[:n_before])
-        for s in states:
-            key = round(s.header.stamp.to_sec(), 3)
-            if key not in truth or key not in info_by_stamp or not truth[key][2]:
-                continue
-            p = np.array([truth[key][0], truth[key][1], 1.0])
-            K_out = np.array(info_by_stamp[key].K).reshape(3, 3)
-            R = quat_to_R(s.virtual_rotation).dot(quat_to_R(s.real_rotation).T)
-            q = K_out.dot(R.dot(np.linalg.solve(K_in, p)))
-            head_in.append(p[:2])
-            head_out.append(q[:2] / q[2])
-        self.assertGreater(len(head_in), 30)
-        j_in, j_out = highpass_rms(head_in, 30.0), highpass_rms(head_out, 30.0)
-        rospy.loginfo("head jitter: input %.2f px, output %.2f px", j_in, j_out)
-        print("head jitter: input %.2f px, output %.2f px" % (j_in, j_out))
-        self.assertLess(j_out, 0.5 * j_in)
 
 
 if __name__ == "__main__":
@@ -379,4 +417,6 @@ if __name__ == "__main__":
     ARGS, rest = p.parse_known_args(rospy.myargv()[1:])
     sys.argv = [sys.argv[0]] + rest
     rospy.init_node("stabilizer_rostest")
-    rostest.rosrun("steadiface", "stabilizer_rostest", StabilizerTest, sys.argv)
+    case = (LayeredTest if ARGS.layered else EquivalenceTest if ARGS.equivalence else
+            BagLoopTest if ARGS.bag_loop else NoImuTest if ARGS.no_imu else StabilizerTest)
+    rostest.rosrun("steadiface", "stabilizer_rostest", case, sys.argv)
