@@ -24,6 +24,7 @@
 
 #include "steadiface_core/calibration/calibrator.h"
 #include "steadiface_core/check/gyro_video_check.h"
+#include "steadiface_core/common/command_line.h"
 #include "steadiface_core/sim/simulator.h"
 
 namespace {
@@ -66,38 +67,28 @@ int main(int argc, char** argv) {
   for (int i = 0; i < 24; ++i) perms.push_back(i);
   double duration = 3.0, tilt_deg = 2.0;
   bool full = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--help" || a == "-h") {
-      Usage();
-      return 0;
-    }
-    if (a == "--data")
-      data = next();
-    else if (a == "--offsets")
-      offsets = Numbers(next());
-    else if (a == "--readouts")
-      readouts = Numbers(next());
-    else if (a == "--seeds")
-      seeds = Numbers(next());
-    else if (a == "--formats")
-      formats = Words(next());
-    else if (a == "--duration")
-      duration = std::atof(next().c_str());
-    else if (a == "--tilt")
-      tilt_deg = std::atof(next().c_str());
-    else if (a == "--full")
-      full = true;
-    else if (a == "--permutations") {
-      const std::string p = next();
-      if (p != "all") {
-        perms.clear();
-        for (double v : Numbers(p)) perms.push_back(static_cast<int>(v));
-      }
-    } else {
-      return Usage();
-    }
+  CommandLine cl;
+  cl.String("--data", &data).Double("--duration", &duration).Double("--tilt", &tilt_deg);
+  cl.Flag("--full", &full);
+  cl.Value("--offsets", "numbers", [&](const std::string& v) { return !(offsets = Numbers(v)).empty(); });
+  cl.Value("--readouts", "numbers", [&](const std::string& v) { return !(readouts = Numbers(v)).empty(); });
+  cl.Value("--seeds", "numbers", [&](const std::string& v) { return !(seeds = Numbers(v)).empty(); });
+  cl.Value("--formats", "words", [&](const std::string& v) { return !(formats = Words(v)).empty(); });
+  cl.Value("--permutations", "'all' or numbers", [&](const std::string& p) {
+    if (p == "all") return true;
+    perms.clear();
+    for (double v : Numbers(p)) perms.push_back(static_cast<int>(v));
+    return !perms.empty();
+  });
+  std::string error;
+  const CommandLine::Result parsed = cl.Parse(argc, argv, &error);
+  if (parsed == CommandLine::Result::kHelp) {
+    Usage();
+    return 0;
+  }
+  if (parsed == CommandLine::Result::kError) {
+    std::cerr << "steadiface_calibration_sweep: " << error << "\n";
+    return Usage();
   }
   if (data.empty() || offsets.empty() || readouts.empty() || seeds.empty() ||
       formats.empty() || perms.empty()) {

@@ -22,6 +22,7 @@
 #include <functional>
 #include <memory>
 
+#include "steadiface_core/common/command_line.h"
 #include "steadiface_core/eval/feasible_offsets.h"
 #include "steadiface_core/eval/ffmpeg_baseline.h"
 #include "steadiface_core/eval/run_methods.h"
@@ -155,46 +156,37 @@ int main(int argc, char** argv) {
   double reach_hold = NAN;       // stabilizer.subject_reach_hold (NaN: default)
   bool feasible_set = false;     // --feasible-set: write feasible_<preset>_<method>.csv
   double feasible_roll = 0.0;    // --feasible-roll MAX [rad]; 0: none
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--help" || a == "-h") {
-      Usage();
-      return 0;
-    }
-    if (a == "--data") data = next();
-    else if (a == "--out") out_dir = next();
-    else if (a == "--presets") presets = Split(next());
-    else if (a == "--methods") methods = Split(next());
-    else if (a == "--duration") duration = std::atof(next().c_str());
-    else if (a == "--seed") seed = std::strtoull(next().c_str(), nullptr, 10);
-    else if (a == "--render") render = true;
-    else if (a == "--crop") crop = std::atof(next().c_str());
-    else if (a == "--offset-error") offset_error = std::atof(next().c_str());
-    else if (a == "--readout-error") readout_error = std::atof(next().c_str());
-    else if (a == "--gyro-scale") gyro_scale = std::atof(next().c_str());
-    else if (a == "--gyro-speed") gyro_speed = std::atof(next().c_str());
-    else if (a == "--search-interval") search_interval = std::atof(next().c_str());
-    else if (a == "--head-w-stay") head_w_stay = std::atof(next().c_str());
-    else if (a == "--head-d-ref") head_d_ref = std::atof(next().c_str());
-    else if (a == "--subject-reach") subject_reach = std::atof(next().c_str());
-    else if (a == "--reach-lowpass") reach_lowpass = std::atof(next().c_str());
-    else if (a == "--reach-hold") reach_hold = std::atof(next().c_str());
-    else if (a == "--feasible-set") feasible_set = true;
-    else if (a == "--feasible-roll")
-      feasible_roll = std::atof(next().c_str());
-    else if (a == "--band") blend.band_width = std::atof(next().c_str());
-    else if (a == "--band-inside") blend.band_inside = std::atof(next().c_str());
-    else if (a == "--outline-margin") blend.outline_margin_cells = std::atof(next().c_str());
-    else if (a == "--max-offset") blend.max_offset = std::atof(next().c_str());
-    else if (a == "--yield-to-background")
-      blend.yield_to_subject = false;
-    else if (a == "--offset-lowpass") blend.offset_lowpass_hz = std::atof(next().c_str());
-    else if (a == "--size") {
-      if (std::sscanf(next().c_str(), "%dx%d", &width, &height) != 2) return Usage();
-    } else {
-      return Usage();
-    }
+  steadiface::CommandLine cl;
+  cl.String("--data", &data).String("--out", &out_dir);
+  cl.Value("--presets", "a comma-separated list",
+           [&](const std::string& v) { return !(presets = Split(v)).empty(); });
+  cl.Value("--methods", "a comma-separated list",
+           [&](const std::string& v) { return !(methods = Split(v)).empty(); });
+  cl.Double("--duration", &duration).UInt64("--seed", &seed).Flag("--render", &render);
+  cl.Double("--crop", &crop).Double("--offset-error", &offset_error);
+  cl.Double("--readout-error", &readout_error).Double("--gyro-scale", &gyro_scale);
+  cl.Double("--gyro-speed", &gyro_speed).Double("--search-interval", &search_interval);
+  cl.Double("--head-w-stay", &head_w_stay).Double("--head-d-ref", &head_d_ref);
+  cl.Double("--subject-reach", &subject_reach).Double("--reach-lowpass", &reach_lowpass);
+  cl.Double("--reach-hold", &reach_hold).Flag("--feasible-set", &feasible_set);
+  cl.Double("--feasible-roll", &feasible_roll).Double("--band", &blend.band_width);
+  cl.Double("--band-inside", &blend.band_inside);
+  cl.Double("--outline-margin", &blend.outline_margin_cells);
+  cl.Double("--max-offset", &blend.max_offset);
+  cl.ClearFlag("--yield-to-background", &blend.yield_to_subject);
+  cl.Double("--offset-lowpass", &blend.offset_lowpass_hz);
+  cl.Value("--size", "WxH", [&](const std::string& v) {
+    return std::sscanf(v.c_str(), "%dx%d", &width, &height) == 2;
+  });
+  std::string error;
+  const steadiface::CommandLine::Result parsed = cl.Parse(argc, argv, &error);
+  if (parsed == steadiface::CommandLine::Result::kHelp) {
+    Usage();
+    return 0;
+  }
+  if (parsed == steadiface::CommandLine::Result::kError) {
+    std::cerr << "steadiface_evaluate: " << error << "\n";
+    return Usage();
   }
   if (data.empty() || out_dir.empty()) return Usage();
   std::string ffmpeg_version;

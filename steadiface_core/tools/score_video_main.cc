@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "steadiface_core/common/command_line.h"
 #include "steadiface_core/eval/ffmpeg_baseline.h"
 #include "steadiface_core/eval/video_scorer.h"
 
@@ -25,26 +26,24 @@ std::string Num(double v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string path, name;
+  std::string name;
   double fps = 30.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::cerr << "usage: steadiface_score_video VIDEO [--fps F] [--name LABEL]\n";
-      return 0;
-    }
-    if (a == "--fps" && i + 1 < argc) fps = std::atof(argv[++i]);
-    else if (a == "--name" && i + 1 < argc) name = argv[++i];
-    else if (!a.empty() && a[0] != '-' && path.empty()) path = a;
-    else {
-      std::cerr << "usage: steadiface_score_video VIDEO [--fps F] [--name LABEL]\n";
-      return 2;
-    }
+  std::vector<std::string> paths;
+  steadiface::CommandLine cl;
+  cl.Double("--fps", &fps).String("--name", &name).Positional(&paths);
+  std::string error;
+  const steadiface::CommandLine::Result parsed = cl.Parse(argc, argv, &error);
+  const char* usage = "usage: steadiface_score_video VIDEO [--fps F] [--name LABEL]\n";
+  if (parsed == steadiface::CommandLine::Result::kHelp) {
+    std::cerr << usage;
+    return 0;
   }
-  if (path.empty()) {
-    std::cerr << "usage: steadiface_score_video VIDEO [--fps F] [--name LABEL]\n";
+  if (parsed == steadiface::CommandLine::Result::kError || paths.size() != 1) {
+    if (!error.empty()) std::cerr << "steadiface_score_video: " << error << "\n";
+    std::cerr << usage;
     return 2;
   }
+  const std::string path = paths[0];
   std::unique_ptr<steadiface::eval::VideoScorer> scorer;
   steadiface::eval::VideoScorerOptions o;
   o.fps = fps;

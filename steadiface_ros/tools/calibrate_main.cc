@@ -22,6 +22,7 @@
 #include "steadiface_bag/bag_reader.h"
 #include "steadiface_bag/bounded_queue.h"
 #include "steadiface_core/calibration/calibrator.h"
+#include "steadiface_core/common/command_line.h"
 #include "steadiface_ros/camera_info_source.h"
 #include "steadiface_ros/msg_conversion.h"
 #include "steadiface_ros/params.h"
@@ -98,32 +99,17 @@ int main(int argc, char** argv) {
   std::vector<std::string> extra_params;
   steadiface_bag::BagTopics topics;
   bool quiet = false, readout = true;
-  for (int i = 1; i < argc; ++i) {
-    const std::string s = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (s == "--help" || s == "-h") return Usage(std::cout);
-    if (s == "--in")
-      in = next();
-    else if (s == "--out")
-      out = next();
-    else if (s == "--report")
-      report = next();
-    else if (s == "--plot")
-      plot = next();
-    else if (s == "--image")
-      topics.image = next();
-    else if (s == "--info")
-      topics.info = next();
-    else if (s == "--imu")
-      topics.imu = next();
-    else if (s == "--params")
-      extra_params.push_back(next());
-    else if (s == "--quiet")
-      quiet = true;
-    else if (s == "--no-readout")
-      readout = false;
-    else
-      return Usage(std::cerr);
+  steadiface::CommandLine cl;
+  cl.String("--in", &in).String("--out", &out).String("--report", &report);
+  cl.String("--plot", &plot).String("--image", &topics.image).String("--info", &topics.info);
+  cl.String("--imu", &topics.imu).Strings("--params", &extra_params);
+  cl.Flag("--quiet", &quiet).ClearFlag("--no-readout", &readout);
+  std::string error;
+  const steadiface::CommandLine::Result parsed = cl.Parse(argc, argv, &error);
+  if (parsed == steadiface::CommandLine::Result::kHelp) return Usage(std::cout);
+  if (parsed == steadiface::CommandLine::Result::kError) {
+    std::cerr << "steadiface_calibrate: " << error << "\n";
+    return Usage(std::cerr);
   }
   if (in.empty() || out.empty()) return Usage(std::cerr);
   // The starting point: the package defaults and the user's overlays.

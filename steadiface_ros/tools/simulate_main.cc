@@ -21,6 +21,7 @@
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/image_encodings.h>
 
+#include "steadiface_core/common/command_line.h"
 #include "steadiface_core/sim/simulator.h"
 #include "steadiface_ros/msg_conversion.h"
 #include "steadiface_ros/time_conversion.h"
@@ -55,49 +56,40 @@ int main(int argc, char** argv) {
               imu_topic = "/imu", camera_frame = "camera_optical", imu_frame = "camera_optical",
               calibration_out, compress_images;
   Eigen::Quaterniond R_imu_cam = Eigen::Quaterniond::Identity();
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--help" || a == "-h") {
-      Usage();
-      return 0;
-    }
-    if (a == "--preset") preset = next();
-    else if (a == "--out") out = next();
-    else if (a == "--duration") o.duration_s = std::atof(next().c_str());
-    else if (a == "--fps") o.fps = std::atof(next().c_str());
-    else if (a == "--imu-rate") o.imu_rate_hz = std::atof(next().c_str());
-    else if (a == "--seed") o.seed = std::strtoull(next().c_str(), nullptr, 10);
-    else if (a == "--background") o.background_photo = next();
-    else if (a == "--mono") mono = true;
-    else if (a == "--no-face") o.render_face = false;
-    else if (a == "--data") data = next();
-    else if (a == "--clock-offset") o.imu_clock_offset_s = std::atof(next().c_str());
-    else if (a == "--readout") readout = std::atof(next().c_str());
-    else if (a == "--epoch") epoch = std::atof(next().c_str());
-    else if (a == "--hfov") o.hfov_rad = std::atof(next().c_str());
-    else if (a == "--image-topic") image_topic = next();
-    else if (a == "--info-topic") info_topic = next();
-    else if (a == "--imu-topic") imu_topic = next();
-    else if (a == "--camera-frame") camera_frame = next();
-    else if (a == "--imu-frame") imu_frame = next();
-    else if (a == "--calibration-out") calibration_out = next();
-    else if (a == "--compress-images") {
-      compress_images = next();
-      if (compress_images != "jpeg" && compress_images != "png") return Usage();
-    }
-    else if (a == "--imu-rotation") {
-      double x, y, z, w;
-      if (std::sscanf(next().c_str(), "%lf,%lf,%lf,%lf", &x, &y, &z, &w) != 4) return Usage();
-      R_imu_cam = Eigen::Quaterniond(w, x, y, z);
-      if (!(R_imu_cam.norm() > 0.5)) return Usage();
-      R_imu_cam.normalize();
-    }
-    else if (a == "--size") {
-      if (std::sscanf(next().c_str(), "%dx%d", &o.width, &o.height) != 2) return Usage();
-    } else {
-      return Usage();
-    }
+  steadiface::CommandLine cl;
+  cl.String("--preset", &preset).String("--out", &out).String("--data", &data);
+  cl.Double("--duration", &o.duration_s).Double("--fps", &o.fps);
+  cl.Double("--imu-rate", &o.imu_rate_hz).UInt64("--seed", &o.seed);
+  cl.String("--background", &o.background_photo).Flag("--mono", &mono);
+  cl.ClearFlag("--no-face", &o.render_face).Double("--clock-offset", &o.imu_clock_offset_s);
+  cl.Double("--readout", &readout).Double("--epoch", &epoch).Double("--hfov", &o.hfov_rad);
+  cl.String("--image-topic", &image_topic).String("--info-topic", &info_topic);
+  cl.String("--imu-topic", &imu_topic).String("--camera-frame", &camera_frame);
+  cl.String("--imu-frame", &imu_frame).String("--calibration-out", &calibration_out);
+  cl.Value("--compress-images", "jpeg or png", [&](const std::string& v) {
+    compress_images = v;
+    return v == "jpeg" || v == "png";
+  });
+  cl.Value("--imu-rotation", "x,y,z,w of a rotation", [&](const std::string& v) {
+    double x, y, z, w;
+    if (std::sscanf(v.c_str(), "%lf,%lf,%lf,%lf", &x, &y, &z, &w) != 4) return false;
+    R_imu_cam = Eigen::Quaterniond(w, x, y, z);
+    if (!(R_imu_cam.norm() > 0.5)) return false;
+    R_imu_cam.normalize();
+    return true;
+  });
+  cl.Value("--size", "WxH", [&](const std::string& v) {
+    return std::sscanf(v.c_str(), "%dx%d", &o.width, &o.height) == 2;
+  });
+  std::string error;
+  const steadiface::CommandLine::Result parsed = cl.Parse(argc, argv, &error);
+  if (parsed == steadiface::CommandLine::Result::kHelp) {
+    Usage();
+    return 0;
+  }
+  if (parsed == steadiface::CommandLine::Result::kError) {
+    std::cerr << "steadiface_simulate: " << error << "\n";
+    return Usage();
   }
   if (out.empty()) return Usage();
   if (data.empty()) data = ros::package::getPath("steadiface") + "/test/data";

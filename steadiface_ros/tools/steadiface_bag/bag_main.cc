@@ -34,6 +34,7 @@
 #include "steadiface_bag/bag_report.h"
 #include "steadiface_bag/bag_stabilizer.h"
 #include "steadiface_bag/bag_writer.h"
+#include "steadiface_core/common/command_line.h"
 #include "steadiface_core/face/landmark_predictor.h"
 #include "steadiface_ros/camera_info_source.h"
 #include "steadiface_ros/params.h"
@@ -112,60 +113,27 @@ int main(int argc, char** argv) {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
   Args a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string s = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (s == "--in")
-      a.in = next();
-    else if (s == "--out")
-      a.out = next();
-    else if (s == "--params")
-      a.params.push_back(next());
-    else if (s == "--image")
-      a.topics.image = next();
-    else if (s == "--info")
-      a.topics.info = next();
-    else if (s == "--imu")
-      a.topics.imu = next();
-    else if (s == "--landmarks")
-      a.topics.landmarks = next();
-    else if (s == "--compress")
-      a.compress = next();
-    else if (s == "--debug-images-in-bag")
-      a.debug_images_in_bag = true;
-    else if (s == "--video")
-      a.video = next();
-    else if (s == "--debug-overlay")
-      a.debug_overlay = true;
-    else if (s == "--report")
-      a.report = next();
-    else if (s == "--trajectory")
-      a.trajectory = next();
-    else if (s == "--gyro-only")
-      a.gyro_only = true;
-    else if (s == "--no-pipeline")
-      a.no_pipeline = true;
-    else if (s == "--rosbag-reader")
-      a.rosbag_reader = true;
-    else if (s == "--verify-checksums")
-      a.verify_checksums = true;
-    else if (s == "--quiet")
-      a.quiet = true;
-    else if (s == "--truth")
-      a.truth = next();
-    else if (s == "--start-stamp")
-      a.start_stamp = std::atof(next().c_str());
-    else if (s == "--only-stamps")
-      a.only_stamps = next();
-    else if (s == "--plots")
-      a.plot_dir = next();
-    else if (s == "--name")
-      a.plot_name = next();
-    else if (s == "--help" || s == "-h") {
-      Usage();
-      return 0;
-    } else
-      return Usage();
+  steadiface::CommandLine cl;
+  cl.String("--in", &a.in).String("--out", &a.out).Strings("--params", &a.params);
+  cl.String("--image", &a.topics.image).String("--info", &a.topics.info);
+  cl.String("--imu", &a.topics.imu).String("--landmarks", &a.topics.landmarks);
+  cl.String("--compress", &a.compress).Flag("--debug-images-in-bag", &a.debug_images_in_bag);
+  cl.String("--video", &a.video).Flag("--debug-overlay", &a.debug_overlay);
+  cl.String("--report", &a.report).String("--trajectory", &a.trajectory);
+  cl.Flag("--gyro-only", &a.gyro_only).Flag("--no-pipeline", &a.no_pipeline);
+  cl.Flag("--rosbag-reader", &a.rosbag_reader).Flag("--verify-checksums", &a.verify_checksums);
+  cl.Flag("--quiet", &a.quiet).String("--truth", &a.truth);
+  cl.Double("--start-stamp", &a.start_stamp).String("--only-stamps", &a.only_stamps);
+  cl.String("--plots", &a.plot_dir).String("--name", &a.plot_name);
+  std::string error;
+  const steadiface::CommandLine::Result parsed = cl.Parse(argc, argv, &error);
+  if (parsed == steadiface::CommandLine::Result::kHelp) {
+    Usage();
+    return 0;
+  }
+  if (parsed == steadiface::CommandLine::Result::kError) {
+    std::cerr << "steadiface_bag: " << error << "\n";
+    return Usage();
   }
   if (a.in.empty()) return Usage();
   if (a.compress != "none" && a.compress != "lz4" && a.compress != "bz2") {
