@@ -303,6 +303,7 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   }
   if (extrapolated) ++counters_.extrapolated;
   scheduler_.OnFrameDone(stamp);
+  sink_->OnFrameProcessed(frame, *pipeline_);
   if (!pipelined) {
     Publish(p, frame, image, extrapolated, false, started);
     return;

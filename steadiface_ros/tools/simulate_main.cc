@@ -6,6 +6,7 @@
 //       [--duration 3] [--size 640x360] [--fps 30] [--imu-rate 200]
 //       [--seed 1] [--mono] [--data DIR] [--clock-offset S]
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -23,6 +24,7 @@
 
 #include "steadiface_core/common/command_line.h"
 #include "steadiface_core/sim/simulator.h"
+#include "steadiface_core/sim/truth_file.h"
 #include "steadiface_ros/msg_conversion.h"
 #include "steadiface_ros/time_conversion.h"
 
@@ -93,11 +95,17 @@ int main(int argc, char** argv) {
   }
   if (out.empty()) return Usage();
   if (data.empty()) data = ros::package::getPath("steadiface") + "/test/data";
-  o.data_dir = data;
-  const double duration = o.duration_s;
-  steadiface::Status s = steadiface::sim::ApplyPreset(preset, &o);
-  o.duration_s = duration;
-  if (readout >= 0) o.readout_s = readout;
+  // What the truth file records to rebuild this simulation (the data
+  // folder absolute, so the bag can be scored from anywhere).
+  steadiface::sim::SimulationSettings settings;
+  settings.preset = preset;
+  char* abs_data = realpath(data.c_str(), nullptr);
+  settings.data_dir = abs_data ? abs_data : data;
+  free(abs_data);
+  settings.base = o;
+  settings.readout_s = readout;
+  settings.epoch_s = epoch;
+  steadiface::Status s = steadiface::sim::MakeSimulatorOptions(settings, &o);
   std::unique_ptr<steadiface::sim::Simulator> sim;
   if (s.ok()) s = steadiface::sim::Simulator::Create(o, &sim);
   if (!s.ok()) {
@@ -134,10 +142,7 @@ int main(int argc, char** argv) {
     }
   };
   std::ofstream csv(out + ".truth.csv");
-  csv << "frame,stamp,head_x,head_y,head_in_view,face_scale_px,occluded,face_out,second_face";
-  for (int r = 0; r < 16; ++r) csv << ",row" << r << "_qx,row" << r << "_qy,row" << r << "_qz,row" << r << "_qw";
-  csv << "\n";
-  csv.precision(17);
+  steadiface::sim::TruthFileWriter truth_file(&csv, settings);
   for (int i = 0; i < sim->num_frames(); ++i) {
     cv::Mat frame;
     steadiface::sim::SimTruth truth;
@@ -170,11 +175,7 @@ int main(int argc, char** argv) {
       bag.write(image_topic + "/compressed", last_row, c);
     }
     if (info_topic != "none") bag.write(info_topic, last_row, steadiface_ros::ToCameraInfo(k, h));
-    csv << i << "," << stamp.toSec() << "," << truth.head_px.x() << "," << truth.head_px.y() << ","
-        << truth.head_in_view << "," << truth.face_scale_px << "," << truth.occluded << ","
-        << truth.face_out << "," << truth.second_face;
-    for (const auto& q : truth.R_r) csv << "," << q.x() << "," << q.y() << "," << q.z() << "," << q.w();
-    csv << "\n";
+    truth_file.Add(i, stamp.toSec(), truth);
   }
   write_imu(nullptr);
   bag.close();

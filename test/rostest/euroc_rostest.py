@@ -7,7 +7,6 @@ jitter (ground truth from the simulator's CSV, mapped through each frame's
 published warp) falls well below the input's: it would not with the IMU's
 axes taken as the camera's."""
 import argparse
-import csv
 import sys
 from types import SimpleNamespace
 import threading
@@ -24,6 +23,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from steadiface.msg import StabilizerState
 # The scorecard's helpers, shared with the other rostests (same folder).
 from stabilizer_rostest import highpass_rms, quat_to_R
+from truth_file import read_truth
 
 ARGS = None
 
@@ -59,10 +59,9 @@ class EurocTest(unittest.TestCase):
         rospy.Subscriber("/cam0/state", StabilizerState, on_state, queue_size=200)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=50)
         truth = {}
-        with open(ARGS.truth) as f:
-            for r in csv.DictReader(f):
-                truth[round(float(r["stamp"]), 3)] = quat_to_R(
-                    quat(*(float(r["row7_q" + k]) for k in "xyzw")))
+        for r in read_truth(ARGS.truth)[1]:
+            truth[round(float(r["stamp"]), 3)] = quat_to_R(
+                quat(*(float(r["row7_q" + k]) for k in "xyzw")))
         n_frames = len(truth)
         end = time.time() + 70
         last = (-1, time.time())

@@ -22,6 +22,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from tf2_msgs.msg import TFMessage
 
 from steadiface.msg import StabilizerState
+from truth_file import read_truth
 
 ARGS = None
 KEYS = ["gyro", "face", "solver", "frames", "protrusion", "image input rate", "imu input rate"]
@@ -178,9 +179,8 @@ class StabilizerTest(unittest.TestCase):
     def test_3_head_jitter_is_below_half_the_input(self):
         # Ground truth from the simulator's sidecar.
         truth = {}
-        with open(ARGS.truth) as f:
-            for r in csv.DictReader(f):
-                truth[round(float(r["stamp"]), 3)] = (float(r["head_x"]), float(r["head_y"]), r["head_in_view"] == "1")
+        for r in read_truth(ARGS.truth)[1]:
+            truth[round(float(r["stamp"]), 3)] = (float(r["head_x"]), float(r["head_y"]), r["head_in_view"] == "1")
         K_in = np.array(self.c.in_info.K).reshape(3, 3)
         head_in, head_out = [], []
         info_by_stamp = {round(i.header.stamp.to_sec(), 3): i for i in self.infos}
@@ -232,7 +232,7 @@ class BagLoopTest(unittest.TestCase):
         import os
         import subprocess
         import tempfile
-        n_frames = sum(1 for _ in open(ARGS.truth)) - 1
+        n_frames = len(read_truth(ARGS.truth)[1])
 
         def passes(states=None):
             if states is None:
@@ -295,7 +295,7 @@ class EquivalenceTest(unittest.TestCase):
         import os
         import subprocess
         import tempfile
-        n_frames = sum(1 for _ in open(ARGS.truth)) - 1
+        n_frames = len(read_truth(ARGS.truth)[1])
         # Until every frame is in, or (frames missed at the start) the
         # stream has been quiet for 5 s.
         last = {"n": -1, "t": time.time()}

@@ -45,6 +45,38 @@ Status MakeScorecard(const sim::Simulator& sim, const PipelineOptions& options,
   return Status::Ok();
 }
 
+FrameWarp MakeFrameWarp(const PipelineFrame& out, const Pipeline& p, bool rendered) {
+  FrameWarp w;
+  w.kind = FrameWarp::Kind::kPose;
+  w.R_v = out.stabilizer.R_v;
+  w.t = out.stabilizer.t;
+  w.rows = out.stabilizer.rows;
+  w.has_head_target = out.stabilizer.has_target;
+  w.head_target = out.stabilizer.H;
+  const bool layered = p.options().warp.mode == WarpMode::kLayered;
+  if (layered) {
+    // The joined mesh is the warp (the subject pose holds only inside the
+    // region).
+    const WarpMesh& m = p.warper().mesh();
+    w.kind = FrameWarp::Kind::kMesh;
+    w.mesh_u = m.u;
+    w.mesh_v = m.v;
+    w.mesh_source = m.source;
+    w.mesh_background = p.warper().background_mesh();
+    if (p.warper().layer_blend() != nullptr) {
+      w.mesh_blend = p.warper().layer_blend()->vertex_blend();
+    }
+  }
+  w.stage_ms = {{"face", out.timings.face_ms},
+                {"stabilizer", out.timings.stabilizer_ms},
+                {"solver", out.stabilizer.solver.time_ms}};
+  if (layered) w.stage_ms.push_back({"mesh", out.timings.mesh_ms});
+  if (rendered) {
+    w.stage_ms.push_back({"warp", out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms});
+  }
+  return w;
+}
+
 void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_offset_s,
                       Pipeline* pipeline, size_t* next) {
   const auto& imu = sim.imu();
@@ -93,34 +125,7 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
     PipelineFrame out;
     s = p->ProcessFrame(frame, stamp, nullptr, 0.0, &out);
     if (!s.ok()) return Status::Error("frame " + std::to_string(i) + ": " + s.message());
-    FrameWarp w;
-    w.kind = FrameWarp::Kind::kPose;
-    w.R_v = out.stabilizer.R_v;
-    w.t = out.stabilizer.t;
-    w.rows = out.stabilizer.rows;
-    w.has_head_target = out.stabilizer.has_target;
-    w.head_target = out.stabilizer.H;
-    if (o.warp.mode == WarpMode::kLayered) {
-      // The joined mesh is the warp (the subject pose holds only inside the
-      // region).
-      const WarpMesh& m = p->warper().mesh();
-      w.kind = FrameWarp::Kind::kMesh;
-      w.mesh_u = m.u;
-      w.mesh_v = m.v;
-      w.mesh_source = m.source;
-      w.mesh_background = p->warper().background_mesh();
-      if (p->warper().layer_blend() != nullptr) {
-        w.mesh_blend = p->warper().layer_blend()->vertex_blend();
-      }
-    }
-    w.stage_ms = {{"face", out.timings.face_ms},
-                  {"stabilizer", out.timings.stabilizer_ms},
-                  {"solver", out.stabilizer.solver.time_ms}};
-    if (o.warp.mode == WarpMode::kLayered) w.stage_ms.push_back({"mesh", out.timings.mesh_ms});
-    if (render) {
-      w.stage_ms.push_back({"warp", out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms});
-    }
-    card->Add(i, w);
+    card->Add(i, MakeFrameWarp(out, *p, render));
     if (render && on_output) {
       s = on_output(out.output);
       if (!s.ok()) return s;

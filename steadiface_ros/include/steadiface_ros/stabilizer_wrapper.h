@@ -59,6 +59,11 @@ class OutputSink {
   /// keyed by time (the nodelet clears its TF buffer, which would otherwise
   /// refuse the new epoch's transforms as TF_OLD_DATA).
   virtual void OnTimeJump() {}
+  /// A frame the pipeline has just stabilized, before it is rendered or
+  /// published: the pipeline's warper still holds its warp (the bag tool
+  /// scores it against ground truth).
+  virtual void OnFrameProcessed(const steadiface::PipelineFrame& /*frame*/,
+                                const steadiface::Pipeline& /*pipeline*/) {}
   /// The clock the latency in `state` is measured on (the ROS clock in the
   /// nodelet); zero (the default, offline) leaves latency_ms at 0.
   virtual ros::Time Now() const { return ros::Time(); }

@@ -237,6 +237,22 @@ int main(int argc, char** argv) {
     writer.reset(new steadiface_bag::AsyncBagWriter(out.get()));
     sink.out = writer.get();
   }
+  // Ground truth (simulator bags): the run is scored as it goes.
+  std::string truth = a.truth;
+  if (truth.empty() && std::ifstream(a.in + ".truth.csv").good()) truth = a.in + ".truth.csv";
+  std::unique_ptr<steadiface_bag::TruthScorer> scorer;
+  if (!truth.empty()) {
+    st = steadiface_bag::TruthScorer::Create(truth, po, &scorer);
+    if (!st.ok()) {
+      std::cerr << "steadiface_bag: " << st.message() << "; the report has no ground truth\n";
+      scorer.reset();
+    } else {
+      steadiface_bag::TruthScorer* sc = scorer.get();
+      sink.on_frame = [sc](const steadiface::PipelineFrame& f, const steadiface::Pipeline& p) {
+        sc->Add(f.stabilizer.stamp, f, p);
+      };
+    }
+  }
   steadiface_bag::SideBySideVideo video(a.video);
   sink.wants_image = !a.out.empty() || video.enabled();
 
@@ -337,17 +353,13 @@ int main(int argc, char** argv) {
   const steadiface_ros::WrapperStatus ws = wrapper.Status();
   steadiface_bag::ReportInputs r;
   r.in = a.in;
-  r.truth = a.truth;
-  if (r.truth.empty() && std::ifstream(a.in + ".truth.csv").good())
-    r.truth = a.in + ".truth.csv";
+  r.truth = truth;
+  r.scorer = scorer.get();
   r.plot_dir = a.plot_dir;
   r.plot_name = a.plot_name;
   r.gyro_only = a.gyro_only;
   r.elapsed_s = elapsed;
   r.crop_ratio = po.warp.output.crop_ratio;
-  r.virtual_focal_scale = po.camera.virtual_focal_scale;
-  r.have_input_info = stabilizer.have_input_info();
-  r.input_info = stabilizer.input_info();
   const std::string report = steadiface_bag::MakeReport(r, sink, ws);
   if (!a.report.empty()) {
     std::ofstream f(a.report + ".part");

@@ -26,6 +26,61 @@ std::string MethodName(const ReportInputs& r, const BagSink& sink) {
   return layered ? "steadiface-layered" : "steadiface";
 }
 
+// The plot trajectories of one scorecard (scripts/plot_report.py).
+void WritePlot(const std::string& path, const steadiface::eval::Scorecard& card) {
+  std::ofstream f(path);
+  f << "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
+       "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
+  const auto& samples = card.samples();
+  const double t0 = samples.empty() ? 0.0 : samples.front().t;
+  for (const auto& s : samples) {
+    const Eigen::Vector2d ho =
+        s.head_valid ? s.head_out : Eigen::Vector2d::Constant(NAN);
+    f << s.t - t0 << "," << s.head_in.x() << "," << s.head_in.y() << "," << ho.x() << ","
+      << ho.y() << "," << s.head_valid << "," << s.background_out.x() << ","
+      << s.background_out.y() << "," << s.virtual_angle[0] << "," << s.virtual_angle[1] << ","
+      << s.virtual_angle[2] << "," << s.real_angle[0] << "," << s.real_angle[1] << ","
+      << s.real_angle[2] << "," << s.offset.x() << "," << s.offset.y() << "\n";
+  }
+}
+
+std::string Num(double v) {
+  std::ostringstream o;
+  o.precision(6);
+  if (std::isfinite(v)) o << v; else o << "null";
+  return o.str();
+}
+
+// The ground-truth block: eval::Scorecard's figures (steadiface_evaluate's
+// scorer) for the input and the output, on the frames both saw.
+std::string TruthJson(const ReportInputs& r, const BagSink& sink) {
+  const steadiface::eval::Score in = r.scorer->Input(), out = r.scorer->Output();
+  if (!r.plot_dir.empty()) {
+    WritePlot(r.plot_dir + "/traj_" + r.plot_name + "_" + MethodName(r, sink) + ".csv",
+              r.scorer->output_card());
+    if (!r.gyro_only) {
+      WritePlot(r.plot_dir + "/traj_" + r.plot_name + "_none.csv", r.scorer->input_card());
+    }
+  }
+  std::ostringstream tj;
+  tj << ",\n  \"ground_truth\": {\"truth\": \"" << r.truth << "\""
+     << ", \"scorer\": \"eval::Scorecard\", \"frames\": " << r.scorer->frames()
+     << ", \"frames_not_in_truth\": " << r.scorer->unmatched()
+     << ", \"head_jitter_in_px\": " << Num(in.head_jitter_px)
+     << ", \"head_jitter_out_px\": " << Num(out.head_jitter_px)
+     << ", \"head_jitter_out_frac\": " << Num(out.head_jitter_frac)
+     << ", \"background_jitter_in_px\": " << Num(in.background_jitter_px)
+     << ", \"background_jitter_out_px\": " << Num(out.background_jitter_px)
+     << ", \"visible_background_jitter_in_px\": " << Num(in.visible_background_jitter_px)
+     << ", \"visible_background_jitter_out_px\": " << Num(out.visible_background_jitter_px)
+     << ", \"line_deviation_px\": " << Num(out.line_deviation_px)
+     << ", \"distortion\": " << Num(out.distortion)
+     << ", \"min_cell_ratio\": " << Num(out.min_cell_ratio)
+     << ", \"cropping\": " << Num(out.cropping)
+     << ", \"undefined_fraction\": " << Num(out.undefined_fraction) << "}";
+  return tj.str();
+}
+
 }  // namespace
 
 std::string MakeReport(const ReportInputs& r, const BagSink& sink,
@@ -62,140 +117,7 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
                                sink.states.front().header.stamp)
                                   .toSec());
   }
-  // Ground truth (simulator bags): the true head centre and far-background
-  // directions mapped through each frame's warp, as the scorecard does. The
-  // warp of a frame is K_out R_v R_r^-1 K_in^-1 (middle-row R_r; the rolling
-  // shutter's within-frame part is below a pixel here). In layered mode the
-  // head is mapped through the subject layer and the background through the
-  // background layer (the band and the slow whole-frame shift are not
-  // modelled here; steadiface_evaluate scores the exact mesh).
-  std::string truth_json;
-  if (!r.truth.empty() && !sink.states.empty() && r.have_input_info) {
-    std::ifstream tf(r.truth);
-    std::string line;
-    std::getline(tf, line);
-    struct T {
-      Eigen::Vector2d head;
-      bool in_view;
-      std::vector<Eigen::Quaterniond> rows;
-    };
-    std::map<int64_t, T> truth;  // by stamp in ms
-    while (std::getline(tf, line)) {
-      std::vector<double> v;
-      std::stringstream ss(line);
-      std::string cell;
-      while (std::getline(ss, cell, ',')) v.push_back(std::atof(cell.c_str()));
-      if (v.size() < 9 + 64) continue;
-      T t;
-      t.head = Eigen::Vector2d(v[2], v[3]);
-      t.in_view = v[4] != 0;
-      for (int r = 0; r < 16; ++r) {
-        t.rows.emplace_back(v[9 + 4 * r + 3], v[9 + 4 * r], v[9 + 4 * r + 1],
-                            v[9 + 4 * r + 2]);
-      }
-      truth[std::llround(v[1] * 1000.0)] = t;
-    }
-    const Eigen::Matrix3d K_in =
-        (Eigen::Matrix3d() << r.input_info.K[0], 0, r.input_info.K[2], 0,
-         r.input_info.K[4], r.input_info.K[5], 0, 0, 1)
-            .finished();
-    std::vector<Eigen::Vector2d> h_in, h_out, b_in, b_out;
-    Eigen::Vector3d dir = Eigen::Vector3d::Zero();
-    std::ofstream traj_none, traj_method;
-    if (!r.plot_dir.empty()) {
-      const std::string head =
-          "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_"
-          "out_y,"
-          "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty\n";
-      traj_method.open(r.plot_dir + "/traj_" + r.plot_name + "_" +
-                       MethodName(r, sink) + ".csv");
-      traj_method << head;
-      if (!r.gyro_only) {
-        traj_none.open(r.plot_dir + "/traj_" + r.plot_name + "_none.csv");
-        traj_none << head;
-      }
-    }
-    const double t0 = sink.states.front().header.stamp.toSec();
-    for (size_t i = 0; i < sink.states.size() && i < sink.infos_out.size();
-         ++i) {
-      const auto& s = sink.states[i];
-      auto it = truth.find(std::llround(s.header.stamp.toSec() * 1000.0));
-      if (it == truth.end()) continue;
-      const T& t = it->second;
-      Eigen::Quaterniond Rv, Rr;
-      steadiface_ros::ToEigen(s.virtual_rotation, &Rv);
-      steadiface_ros::ToEigen(s.real_rotation, &Rr);
-      const auto& ko = sink.infos_out[i].K;
-      const Eigen::Matrix3d K_out =
-          (Eigen::Matrix3d() << ko[0], 0, ko[2], 0, ko[4], ko[5], 0, 0, 1)
-              .finished();
-      const bool layered = s.warp_mode == "layered" && s.has_background_layer;
-      Eigen::Matrix3d H_head =
-          K_out * (Rv * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
-      Eigen::Matrix3d H = H_head;
-      if (layered) {
-        // The published intrinsics are the background layer's; the subject
-        // layer's differ by its principal offset (output px per unit of t:
-        // fx_out / f_v, f_v = fx_in / W_in * virtual_focal_scale).
-        Eigen::Quaterniond Rb;
-        steadiface_ros::ToEigen(s.background_rotation, &Rb);
-        const double f_v = r.input_info.K[0] / r.input_info.width * r.virtual_focal_scale;
-        Eigen::Matrix3d K_s = K_out;
-        K_s(0, 2) += ko[0] / f_v * (s.principal_offset[0] - s.background_principal_offset[0]);
-        K_s(1, 2) += ko[4] / f_v * (s.principal_offset[1] - s.background_principal_offset[1]);
-        H_head = K_s * (Rv * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
-        H = K_out * (Rb * Rr.conjugate()).toRotationMatrix() * K_in.inverse();
-      }
-      // A far-background direction fixed in the world: the first frame's
-      // view centre, seen in each frame through the true middle-row rotation.
-      const Eigen::Quaterniond R_true = t.rows[7];
-      if (dir.isZero())
-        dir = R_true.conjugate() * Eigen::Vector3d(0.05, 0.03, 1.0);
-      const Eigen::Vector3d c = R_true * dir;
-      const Eigen::Vector2d bin = (K_in * c).hnormalized();
-      const Eigen::Vector2d bout = (H * bin.homogeneous()).hnormalized();
-      b_in.push_back(bin);
-      b_out.push_back(bout);
-      Eigen::Vector2d hout = Eigen::Vector2d::Constant(NAN);
-      if (t.in_view) {
-        hout = (H_head * t.head.homogeneous()).hnormalized();
-        h_in.push_back(t.head);
-        h_out.push_back(hout);
-      }
-      const Eigen::Vector3d vr = steadiface::LogSO3(Rv),
-                            rr = steadiface::LogSO3(Rr);
-      auto row = [&](std::ofstream& f, const Eigen::Vector2d& ho,
-                     const Eigen::Vector2d& bo, const Eigen::Vector3d& v,
-                     const Eigen::Vector3d& r, double tx, double ty) {
-        if (!f.is_open()) return;
-        f << s.header.stamp.toSec() - t0 << "," << t.head.x() << ","
-          << t.head.y() << "," << ho.x() << "," << ho.y() << "," << t.in_view
-          << "," << bo.x() << "," << bo.y() << "," << v.x() << "," << v.y()
-          << "," << v.z() << "," << r.x() << "," << r.y() << "," << r.z() << ","
-          << tx << "," << ty << "\n";
-      };
-      row(traj_method, hout, bout, vr, rr, s.principal_offset[0],
-          s.principal_offset[1]);
-      row(traj_none, t.in_view ? t.head : Eigen::Vector2d::Constant(NAN), bin,
-          rr, rr, 0.0, 0.0);
-    }
-    const double diag = std::hypot(r.input_info.width, r.input_info.height);
-    std::ostringstream tj;
-    tj << ",\n  \"ground_truth\": {\"truth\": \"" << r.truth << "\""
-       << ", \"head_jitter_in_px\": " << HighPassRms(h_in, fps_data, 0.5)
-       << ", \"head_jitter_out_px\": " << HighPassRms(h_out, fps_data, 0.5)
-       << ", \"head_jitter_out_frac\": "
-       << HighPassRms(h_out, fps_data, 0.5) / diag
-       << ", \"background_jitter_in_px\": " << HighPassRms(b_in, fps_data, 0.5)
-       << ", \"background_jitter_out_px\": "
-       << HighPassRms(b_out, fps_data, 0.5)
-       << ", \"cropping\": " << std::pow(1.0 - 2.0 * r.crop_ratio, 2.0)
-       << ", \"undefined_fraction\": "
-       << static_cast<double>(ws.stabilizer.undefined_frames) /
-              std::max<size_t>(1, sink.states.size())
-       << "}";
-    truth_json = tj.str();
-  }
+  const std::string truth_json = r.scorer ? TruthJson(r, sink) : std::string();
   // The gyro-vs-video check as of the last frame.
   std::string check_json;
   if (!sink.states.empty()) {

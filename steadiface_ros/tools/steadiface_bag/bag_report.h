@@ -2,9 +2,8 @@
 
 #include <string>
 
-#include <sensor_msgs/CameraInfo.h>
-
 #include "steadiface_bag/bag_writer.h"
+#include "steadiface_bag/truth_score.h"
 #include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_ros/stabilizer_wrapper.h"
 
@@ -14,22 +13,20 @@ namespace steadiface_bag {
 struct ReportInputs {
   std::string in;     ///< input bag path
   std::string truth;  ///< simulator ground truth CSV ("" = none)
+  /// The run scored against `truth` (null = no ground-truth block).
+  const TruthScorer* scorer = nullptr;
   std::string
       plot_dir;  ///< trajectories for scripts/plot_report.py ("" = none)
   std::string plot_name = "bag";
   bool gyro_only = false;
   double elapsed_s = 0.0;  ///< wall time of the run
   double crop_ratio = 0.0;
-  /// f_v / f_r (camera/virtual_focal_scale): with the output intrinsics it
-  /// gives the output px per unit of principal offset.
-  double virtual_focal_scale = 1.0;
-  bool have_input_info = false;
-  sensor_msgs::CameraInfo input_info;
 };
 
 /// The report JSON: counters, timings, jitter that needs no ground truth
-/// and, with `truth`, the scorecard's ground-truth jitter (the true head
-/// centre and a far-background direction mapped through each frame's warp).
+/// and, with a scorer, eval::Scorecard's ground-truth figures for the input
+/// and the output (the true head centre and far-background directions
+/// mapped through each frame's exact warp, as steadiface_evaluate scores).
 /// Also writes the plot trajectories when `plot_dir` is set.
 std::string MakeReport(const ReportInputs& r, const BagSink& sink,
                        const steadiface_ros::WrapperStatus& ws);

@@ -66,6 +66,8 @@ class BagSink : public steadiface_ros::OutputSink {
   std::vector<steadiface::FaceLandmarks> landmarks;
   std::vector<geometry_msgs::TransformStamped> tfs;
   std::map<std::string, int> warnings;
+  /// Called with every stabilized frame (ground-truth scoring); optional.
+  std::function<void(const steadiface::PipelineFrame&, const steadiface::Pipeline&)> on_frame;
 
   void PublishImage(const sensor_msgs::ImagePtr& image,
                     const sensor_msgs::CameraInfoPtr& info) override;
@@ -79,6 +81,10 @@ class BagSink : public steadiface_ros::OutputSink {
   void PublishDebugImage(const sensor_msgs::ImagePtr& image) override;
   void Warn(const std::string& key, const std::string& text) override;
   void Error(const std::string& key, const std::string& text) override;
+  void OnFrameProcessed(const steadiface::PipelineFrame& frame,
+                        const steadiface::Pipeline& pipeline) override {
+    if (on_frame) on_frame(frame, pipeline);
+  }
 };
 
 /// The side-by-side MP4 (input, or its debug overlay | stabilized), encoded

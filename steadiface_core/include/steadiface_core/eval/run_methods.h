@@ -38,6 +38,12 @@ Status MakeScorecard(const sim::Simulator& sim, const PipelineOptions& options,
 /// until they cover the frame stamped `stamp` up to just past its last row,
 /// as a live node would have them (`imu_time_offset_s` as in the pipeline's
 /// options); advances `*next`.
+/// The warp `pipeline` applied to the frame it just processed (`out`), for
+/// the scorecard: the pose, or in layered mode the joined mesh and the
+/// background layer's, read from the pipeline's warper (so ask before the
+/// next frame). `rendered`: the output was rendered (adds the warp's time).
+FrameWarp MakeFrameWarp(const PipelineFrame& out, const Pipeline& pipeline, bool rendered);
+
 void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_offset_s,
                       Pipeline* pipeline, size_t* next);
 
