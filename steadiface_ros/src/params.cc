@@ -1,6 +1,7 @@
 #include "steadiface_ros/params.h"
 
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -73,35 +74,82 @@ class YamlParamSource : public ParamSource {
   std::vector<YAML::Node> docs_;
 };
 
-// Reads `key` if present; checks [lo, hi]. Records the first error.
+// The table of every key (config/parameters.yaml, generated).
+const std::vector<ParameterSpec>& Table() {
+  static const std::vector<ParameterSpec> table = {
+#include "parameter_table.inc"
+  };
+  return table;
+}
+
+const ParameterSpec* Find(const std::string& key) {
+  static const std::map<std::string, const ParameterSpec*> by_key = [] {
+    std::map<std::string, const ParameterSpec*> m;
+    for (const ParameterSpec& p : Table()) m[p.key] = &p;
+    return m;
+  }();
+  const auto it = by_key.find(key);
+  return it == by_key.end() ? nullptr : it->second;
+}
+
+// Reads `key` if present, checked against its row of the table (range or
+// choices). Records the first error.
 class Reader {
  public:
   explicit Reader(const ParamSource& p) : p_(p) {}
-  void Num(const std::string& key, double* v, double lo, double hi) {
+  void Num(const std::string& key, double* v) {
+    const ParameterSpec* spec = Spec(key, ParameterType::kDouble);
     double x = *v;
     if (!p_.Get(key, &x)) {
       int i;
       if (p_.Get(key, &i)) x = i;
     }
-    if (!std::isfinite(x) || x < lo || x > hi) {
-      Fail(key, x, lo, hi);
+    if (spec == nullptr) return;
+    if (!std::isfinite(x) || x < spec->min || x > spec->max) {
+      Fail(key, x, spec->min, spec->max);
       return;
     }
     *v = x;
   }
-  void Int(const std::string& key, int* v, int lo, int hi) {
+  void Int(const std::string& key, int* v) {
+    const ParameterSpec* spec = Spec(key, ParameterType::kInt);
     int x = *v;
     p_.Get(key, &x);
-    if (x < lo || x > hi) {
-      Fail(key, x, lo, hi);
+    if (spec == nullptr) return;
+    if (x < spec->min || x > spec->max) {
+      Fail(key, x, spec->min, spec->max);
       return;
     }
     *v = x;
   }
-  void Bool(const std::string& key, bool* v) { p_.Get(key, v); }
-  void Str(const std::string& key, std::string* v) { p_.Get(key, v); }
+  void Bool(const std::string& key, bool* v) {
+    Spec(key, ParameterType::kBool);
+    p_.Get(key, v);
+  }
+  void Str(const std::string& key, std::string* v) {
+    Spec(key, ParameterType::kString);
+    p_.Get(key, v);
+  }
+  // One of the key's choices (the table's); *v keeps its value otherwise.
+  void Choice(const std::string& key, std::string* v) {
+    const ParameterSpec* spec = Spec(key, ParameterType::kString);
+    std::string x = *v;
+    p_.Get(key, &x);
+    if (spec == nullptr) return;
+    std::stringstream choices(spec->choices);
+    std::string c, all;
+    while (std::getline(choices, c, '|')) {
+      if (c == x) {
+        *v = x;
+        return;
+      }
+      all += (all.empty() ? "" : " | ") + c;
+    }
+    Error("parameter '" + key + "' must be one of " + all + ", got '" + x + "'");
+  }
   // A file parameter: a plain path, file:// or package:// (ResolveResourceUrl).
   void Path(const std::string& key, std::string* v) {
+    Spec(key, ParameterType::kString);
     std::string url = *v;
     p_.Get(key, &url);
     if (url.empty()) {
@@ -111,13 +159,26 @@ class Reader {
     const Status s = ResolveResourceUrl("parameter '" + key + "'", url, v);
     if (!s.ok()) Error(s.message());
   }
-  void Vec(const std::string& key, std::vector<double>* v) { p_.Get(key, v); }
+  void Vec(const std::string& key, std::vector<double>* v) {
+    Spec(key, ParameterType::kList);
+    p_.Get(key, v);
+  }
   void Error(const std::string& msg) {
     if (error_.empty()) error_ = msg;
   }
   Status status() const { return error_.empty() ? Status::Ok() : Status::Error(error_); }
 
  private:
+  // The key's row; a key the table lacks, or of another type, is an error
+  // (a programming one: params_test reads every key).
+  const ParameterSpec* Spec(const std::string& key, ParameterType type) {
+    const ParameterSpec* spec = Find(key);
+    if (spec == nullptr || spec->type != type) {
+      Error("parameter '" + key + "' is not in config/parameters.yaml as this type");
+      return nullptr;
+    }
+    return spec;
+  }
   void Fail(const std::string& key, double x, double lo, double hi) {
     std::ostringstream e;
     e << "parameter '" << key << "' = " << x << " is out of range [" << lo << ", " << hi
@@ -147,65 +208,57 @@ Status YamlParams(const std::vector<std::string>& paths, std::unique_ptr<ParamSo
   return Status::Ok();
 }
 
-Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
-                   WrapperOptions* wo) {
-  using namespace steadiface;  // NOLINT (source file, not a header)
-  Reader r(params);
-  // ROS layer.
+namespace {
+
+// LoadOptions' pieces, one per section of the table.
+void ReadRosLayer(Reader& r, steadiface::PipelineOptions* po, WrapperOptions* wo) {
+  using steadiface::LandmarkSource;
+  using steadiface::LateFramePolicy;
   r.Str("camera_frame", &wo->camera_frame);
   r.Str("camera_info_url", &wo->camera_info_url);
   r.Str("stabilized_suffix", &wo->stabilized_suffix);
   r.Str("world_frame", &wo->world_frame);
   r.Bool("publish_world_tf", &wo->publish_world_tf);
   r.Bool("imu_extrinsics_from_tf", &wo->imu_extrinsics_from_tf);
-  r.Num("max_gyro_wait", &wo->scheduler.max_gyro_wait_s, 0.0, 5.0);
-  std::string policy = wo->scheduler.late_frame_policy == steadiface::LateFramePolicy::kDrop ? "drop" : "extrapolate";
-  r.Str("late_frame_policy", &policy);
-  if (policy == "drop") {
-    wo->scheduler.late_frame_policy = steadiface::LateFramePolicy::kDrop;
-  } else if (policy == "extrapolate") {
-    wo->scheduler.late_frame_policy = steadiface::LateFramePolicy::kExtrapolate;
-  } else {
-    r.Error("parameter 'late_frame_policy' must be 'extrapolate' or 'drop', got '" + policy + "'");
-  }
-  r.Int("frame_queue_size", &wo->scheduler.frame_queue_size, 1, 1000);
-  r.Num("imu_timeout", &wo->scheduler.imu_timeout_s, 0.01, 60.0);
-  r.Num("imu_gap_warn", &wo->scheduler.imu_gap_warn_s, 0.001, 10.0);
-  r.Num("expected_image_rate", &wo->expected_image_rate, 0.0, 1000.0);
-  r.Num("expected_imu_rate", &wo->expected_imu_rate, 0.0, 100000.0);
+  steadiface::FrameSchedulerOptions& fs = wo->scheduler;
+  r.Num("max_gyro_wait", &fs.max_gyro_wait_s);
+  std::string policy = fs.late_frame_policy == LateFramePolicy::kDrop ? "drop" : "extrapolate";
+  r.Choice("late_frame_policy", &policy);
+  fs.late_frame_policy = policy == "drop" ? LateFramePolicy::kDrop : LateFramePolicy::kExtrapolate;
+  r.Int("frame_queue_size", &fs.frame_queue_size);
+  r.Num("imu_timeout", &fs.imu_timeout_s);
+  r.Num("imu_gap_warn", &fs.imu_gap_warn_s);
+  r.Num("expected_image_rate", &wo->expected_image_rate);
+  r.Num("expected_imu_rate", &wo->expected_imu_rate);
   r.Bool("passthrough_without_imu", &wo->passthrough_without_imu);
   r.Bool("pipelined", &wo->pipelined);
-  r.Num("pipeline_hold", &wo->scheduler.pipeline_hold_s, 0.0, 1.0);
-  std::string source = po->landmark_source == LandmarkSource::kExternal
-                           ? "topic"
-                           : po->landmark_source == LandmarkSource::kNone ? "none" : "dlib";
-  r.Str("landmark_source", &source);
-  if (source == "dlib") {
-    po->landmark_source = LandmarkSource::kDlib;
-  } else if (source == "topic") {
-    po->landmark_source = LandmarkSource::kExternal;
-  } else if (source == "none") {
-    po->landmark_source = LandmarkSource::kNone;
-  } else {
-    r.Error("parameter 'landmark_source' must be 'dlib', 'topic' or 'none', got '" + source + "'");
-  }
-  // Camera.
-  r.Num("camera/readout_time", &po->shutter.readout_time_s, 0.0, 0.2);
-  std::string stamp = "first_row";
-  r.Str("camera/stamp", &stamp);
-  if (stamp == "first_row") {
-    po->shutter.stamp = StampConvention::kFirstRow;
-  } else if (stamp == "middle_row") {
-    po->shutter.stamp = StampConvention::kMiddleRow;
-  } else if (stamp == "last_row") {
-    po->shutter.stamp = StampConvention::kLastRow;
-  } else {
-    r.Error("parameter 'camera/stamp' must be first_row, middle_row or last_row, got '" + stamp + "'");
-  }
-  r.Num("camera/row_time_offset", &po->shutter.row_time_offset_s, -0.5, 0.5);
-  r.Num("camera/virtual_focal_scale", &po->camera.virtual_focal_scale, 0.25, 4.0);
-  // IMU.
-  const Eigen::Quaterniond& q0 = po->imu.R_cam_imu;
+  r.Num("pipeline_hold", &fs.pipeline_hold_s);
+  std::string source = po->landmark_source == LandmarkSource::kExternal ? "topic"
+                       : po->landmark_source == LandmarkSource::kNone   ? "none"
+                                                                        : "dlib";
+  r.Choice("landmark_source", &source);
+  po->landmark_source = source == "topic"  ? LandmarkSource::kExternal
+                        : source == "none" ? LandmarkSource::kNone
+                                           : LandmarkSource::kDlib;
+}
+
+void ReadCamera(Reader& r, steadiface::PipelineOptions* po) {
+  using steadiface::StampConvention;
+  r.Num("camera/readout_time", &po->shutter.readout_time_s);
+  const StampConvention s0 = po->shutter.stamp;
+  std::string stamp = s0 == StampConvention::kMiddleRow ? "middle_row"
+                      : s0 == StampConvention::kLastRow ? "last_row"
+                                                        : "first_row";
+  r.Choice("camera/stamp", &stamp);
+  po->shutter.stamp = stamp == "middle_row" ? StampConvention::kMiddleRow
+                      : stamp == "last_row" ? StampConvention::kLastRow
+                                            : StampConvention::kFirstRow;
+  r.Num("camera/row_time_offset", &po->shutter.row_time_offset_s);
+  r.Num("camera/virtual_focal_scale", &po->camera.virtual_focal_scale);
+}
+
+void ReadImu(Reader& r, steadiface::OrientationTimelineOptions* imu) {
+  const Eigen::Quaterniond& q0 = imu->R_cam_imu;
   std::vector<double> q = {q0.x(), q0.y(), q0.z(), q0.w()};
   r.Vec("imu/R_cam_imu", &q);
   if (q.size() != 4) {
@@ -215,158 +268,183 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
     if (!(e.norm() > 0.5 && e.norm() < 2.0)) {
       r.Error("parameter 'imu/R_cam_imu' must be a unit quaternion [x, y, z, w]");
     } else {
-      po->imu.R_cam_imu = e.normalized();
+      imu->R_cam_imu = e.normalized();
     }
   }
-  r.Num("imu/time_offset", &po->imu.imu_time_offset_s, -1.0, 1.0);
-  {
-    const Eigen::Vector3d& b0 = po->imu.gyro_bias;
-    std::vector<double> b = {b0.x(), b0.y(), b0.z()};
-    r.Vec("imu/gyro_bias", &b);
-    if (b.size() != 3 || !std::isfinite(b[0]) || !std::isfinite(b[1]) || !std::isfinite(b[2]) ||
-        Eigen::Vector3d(b[0], b[1], b[2]).norm() >= 1.0) {
-      r.Error("parameter 'imu/gyro_bias' must be [bx, by, bz] in rad/s with |bias| < 1");
-    } else {
-      po->imu.gyro_bias = Eigen::Vector3d(b[0], b[1], b[2]);
-    }
-  }
-  r.Num("imu/buffer_duration", &po->imu.buffer_duration_s, 0.5, 600.0);
-  r.Int("imu/max_samples", &po->imu.max_samples, 16, 10000000);
-  r.Num("imu/max_angular_rate", &po->imu.max_angular_rate, 0.1, 1000.0);
-  r.Num("imu/max_gap", &po->imu.max_gap_s, 0.001, 10.0);
-  r.Num("imu/max_extrapolation", &po->imu.max_extrapolation_s, 0.0, 1.0);
-  // Face.
-  FaceTrackerOptions& f = po->face;
-  std::string det = f.detector.type == FaceDetectorType::kOpenCvCascade ? "opencv_cascade" : "dlib_hog";
-  r.Str("face/detector", &det);
-  if (det == "dlib_hog") {
-    f.detector.type = FaceDetectorType::kDlibHog;
-  } else if (det == "opencv_cascade") {
-    f.detector.type = FaceDetectorType::kOpenCvCascade;
+  r.Num("imu/time_offset", &imu->imu_time_offset_s);
+  const Eigen::Vector3d& b0 = imu->gyro_bias;
+  std::vector<double> b = {b0.x(), b0.y(), b0.z()};
+  r.Vec("imu/gyro_bias", &b);
+  if (b.size() != 3 || !std::isfinite(b[0]) || !std::isfinite(b[1]) || !std::isfinite(b[2]) ||
+      Eigen::Vector3d(b[0], b[1], b[2]).norm() >= 1.0) {
+    r.Error("parameter 'imu/gyro_bias' must be [bx, by, bz] in rad/s with |bias| < 1");
   } else {
-    r.Error("parameter 'face/detector' must be dlib_hog or opencv_cascade, got '" + det + "'");
+    imu->gyro_bias = Eigen::Vector3d(b[0], b[1], b[2]);
   }
-  r.Int("face/detector_max_side", &f.detector.max_side_px, 64, 8192);
+  r.Num("imu/buffer_duration", &imu->buffer_duration_s);
+  r.Int("imu/max_samples", &imu->max_samples);
+  r.Num("imu/max_angular_rate", &imu->max_angular_rate);
+  r.Num("imu/max_gap", &imu->max_gap_s);
+  r.Num("imu/max_extrapolation", &imu->max_extrapolation_s);
+}
+
+void ReadFace(Reader& r, steadiface::FaceTrackerOptions* f) {
+  using steadiface::FaceDetectorType;
+  std::string det =
+      f->detector.type == FaceDetectorType::kOpenCvCascade ? "opencv_cascade" : "dlib_hog";
+  r.Choice("face/detector", &det);
+  f->detector.type =
+      det == "opencv_cascade" ? FaceDetectorType::kOpenCvCascade : FaceDetectorType::kDlibHog;
+  r.Int("face/detector_max_side", &f->detector.max_side_px);
   // Resolved only where it is used: a package:// cascade must not stop a
   // dlib_hog run started outside a sourced workspace.
-  if (f.detector.type == FaceDetectorType::kOpenCvCascade) {
-    r.Path("face/cascade_path", &f.detector.cascade_path);
+  if (f->detector.type == FaceDetectorType::kOpenCvCascade) {
+    r.Path("face/cascade_path", &f->detector.cascade_path);
   } else {
-    r.Str("face/cascade_path", &f.detector.cascade_path);
+    r.Str("face/cascade_path", &f->detector.cascade_path);
   }
-  r.Num("face/dlib_threshold", &f.detector.dlib_threshold, -2.0, 5.0);
-  r.Int("face/min_face_px", &f.detector.min_face_px, 8, 4096);
-  r.Path("face/landmark_model", &f.landmark_model_path);
-  r.Int("face/redetect_every", &f.redetect_every_frames, 1, 10000);
-  r.Num("face/redetect_region_scale", &f.redetect_region_scale, 1.0, 10.0);
-  r.Int("face/redetect_face_px", &f.redetect_face_px, 60, 1000);
-  r.Num("face/lost_timeout", &f.lost_timeout_s, 0.0, 60.0);
-  r.Num("face/search_interval", &f.search_interval_s, 0.0, 10.0);
-  r.Num("face/max_shape_residual", &f.max_shape_residual, 0.001, 2.0);
-  r.Num("face/min_spread_ratio", &f.min_spread_ratio, 0.01, 10.0);
-  r.Num("face/max_spread_ratio", &f.max_spread_ratio, 0.01, 10.0);
-  r.Num("face/max_jump", &f.max_jump, 0.01, 20.0);
-  r.Num("face/min_appearance", &f.min_appearance, -1.0, 0.999);
-  r.Bool("face/estimate_head_pose", &f.estimate_head_pose);
-  // Stabilizer.
-  StabilizerOptions& s = po->stabilizer;
-  r.Num("head/w_stay", &s.head.w_stay, 0.0, 1e9);
-  r.Num("head/w_follow", &s.head.w_follow, 0.0, 1e9);
-  r.Num("head/d_ref", &s.head.d_ref, 1e-6, 1.0);
-  r.Num("weights/fit", &s.weights.fit, 0.0, 1e6);
-  r.Num("weights/distortion", &s.weights.distortion, 0.0, 1e6);
-  r.Num("weights/follow", &s.weights.follow, 0.0, 1e6);
-  r.Num("weights/rotation_c0", &s.weights.rotation_c0, 0.0, 1e6);
-  r.Num("weights/rotation_c1", &s.weights.rotation_c1, 0.0, 1e6);
-  r.Num("weights/translation_c0", &s.weights.translation_c0, 1e-6, 1e6);
-  r.Num("weights/translation_c1", &s.weights.translation_c1, 0.0, 1e6);
-  r.Num("weights/protrusion", &s.weights.protrusion, 0.0, 1e6);
-  r.Num("terms/distortion_threshold", &s.terms.distortion_threshold_rad, 0.0, 1.5);
-  r.Num("terms/distortion_slope", &s.terms.distortion_slope, 1.0, 1e4);
-  r.Num("terms/protrusion_alpha", &s.terms.protrusion_alpha, 1e-5, 1.0);
-  r.Num("terms/protrusion_shrink", &s.terms.protrusion_shrink, 0.0, 0.2);
-  r.Int("terms/protrusion_samples_per_edge", &s.terms.protrusion_samples_per_edge, 2, 256);
-  r.Bool("dynamic/enabled", &s.dynamic.enabled);
-  r.Num("dynamic/fade_time", &s.dynamic.fade_time_s, 0.0, 10.0);
-  r.Num("dynamic/gyro_window", &s.dynamic.gyro_window_s, 0.02, 10.0);
-  r.Num("dynamic/gyro_still", &s.dynamic.gyro_still_rad_s, 0.0, 10.0);
-  r.Num("dynamic/gyro_active", &s.dynamic.gyro_active_rad_s, 1e-6, 20.0);
-  r.Num("dynamic/gyro_still_fit_scale", &s.dynamic.gyro_still_fit_scale, 0.0, 1.0);
-  r.Num("dynamic/pose_low", &s.dynamic.pose_low_rad, 0.0, 1.6);
-  r.Num("dynamic/pose_high", &s.dynamic.pose_high_rad, 1e-6, 3.2);
-  r.Num("dynamic/pose_min_fit_scale", &s.dynamic.pose_min_fit_scale, 0.0, 1.0);
-  r.Num("dynamic/pose_smoothness_boost", &s.dynamic.pose_smoothness_boost, 0.0, 100.0);
-  r.Int("dynamic/variation_window", &s.dynamic.variation_window, 3, 1000);
-  r.Num("dynamic/centre_variation_low", &s.dynamic.centre_variation_low, 0.0, 1.0);
-  r.Num("dynamic/centre_variation_high", &s.dynamic.centre_variation_high, 1e-9, 2.0);
-  r.Num("dynamic/scale_variation_low", &s.dynamic.scale_variation_low, 0.0, 10.0);
-  r.Num("dynamic/scale_variation_high", &s.dynamic.scale_variation_high, 1e-9, 20.0);
-  r.Num("dynamic/variation_min_fit_scale", &s.dynamic.variation_min_fit_scale, 0.0, 1.0);
-  r.Int("solver/max_iterations", &s.solver.max_iterations, 1, 1000);
-  r.Num("solver/function_tolerance", &s.solver.function_tolerance, 1e-16, 0.1);
-  r.Num("solver/max_time", &s.solver.max_time_s, 1e-4, 10.0);
-  r.Int("stabilizer/protrusion_search_steps", &s.protrusion_search_steps, 1, 60);
-  r.Int("stabilizer/row_rotation_samples", &s.row_rotation_samples, 1, 4096);
-  r.Num("stabilizer/min_face_confidence", &s.min_face_confidence, 0.0, 1.0);
-  r.Bool("stabilizer/gyro_only", &s.gyro_only);
-  r.Bool("stabilizer/background_layer", &s.background_layer);
-  r.Bool("stabilizer/smooth_head_in_virtual_view", &s.smooth_head_in_virtual_view);
-  r.Num("stabilizer/intentional_window", &s.intentional_window_s, 0.0, 5.0);
-  r.Num("stabilizer/subject_reach", &s.subject_reach, 0.0, 10.0);
-  // Output and warp.
-  r.Num("output/crop_ratio", &po->warp.output.crop_ratio, 0.0, 0.4);
-  r.Int("output/width", &po->warp.output.width, 0, 16384);
-  r.Int("output/height", &po->warp.output.height, 0, 16384);
-  r.Int("warp/mesh_cols", &po->warp.mesh_cols, 1, 512);
-  r.Int("warp/mesh_rows", &po->warp.mesh_rows, 1, 512);
-  r.Int("warp/num_threads", &po->warp.num_threads, 0, 256);
-  r.Bool("warp/fixed_point_maps", &po->warp.fixed_point_maps);
-  std::string mode = WarpModeName(po->warp.mode);
-  r.Str("warp/mode", &mode);
-  {
-    const Status ms = ParseWarpMode(mode, &po->warp.mode);
-    if (!ms.ok()) r.Error("parameter 'warp/mode': " + ms.message());
-  }
-  LayeredWarpOptions& lw = po->warp.layered;
-  r.Int("warp/layered/mesh_cols", &lw.mesh_cols, 2, 512);
-  r.Int("warp/layered/mesh_rows", &lw.mesh_rows, 2, 512);
-  r.Num("warp/layered/band_width", &lw.blend.band_width, 0.02, 10.0);
-  r.Num("warp/layered/band_inside", &lw.blend.band_inside, 0.0, 1.0);
-  r.Num("warp/layered/outline_margin", &lw.blend.outline_margin_cells, 0.0, 4.0);
-  r.Num("warp/layered/max_offset", &lw.blend.max_offset, 0.0, 10.0);
-  r.Num("warp/layered/offset_lowpass", &lw.blend.offset_lowpass_hz, 0.0, 10.0);
-  r.Num("warp/layered/band_data_weight", &lw.blend.band_data_weight, 1e-6, 1.0);
-  r.Num("warp/layered/shape_weight", &lw.blend.shape_weight, 0.0, 1e4);
-  r.Num("warp/layered/temporal_weight", &lw.blend.temporal_weight, 0.0, 1e4);
-  r.Num("warp/layered/min_cell_ratio", &lw.blend.min_cell_ratio, 0.0, 0.99);
-  r.Bool("warp/layered/yield_to_subject", &lw.blend.yield_to_subject);
-  r.Num("warp/layered/head_width_scale", &lw.region.head_width_scale, 0.2, 5.0);
-  r.Num("warp/layered/head_top_scale", &lw.region.head_top_scale, 0.0, 3.0);
-  r.Bool("warp/layered/torso", &lw.region.torso);
-  r.Num("warp/layered/shoulder_width_scale", &lw.region.shoulder_width_scale, 0.2, 10.0);
-  r.Num("warp/layered/neck_width_scale", &lw.region.neck_width_scale, 0.05, 5.0);
-  r.Num("warp/layered/region_smoothing", &lw.region.smoothing_s, 0.0, 10.0);
-  r.Num("warp/layered/ramp", &lw.region.ramp_s, 0.01, 60.0);
-  // The gyro-vs-video check.
-  GyroVideoCheckOptions& c = po->gyro_video_check;
-  r.Bool("gyro_video_check/enabled", &c.enabled);
-  r.Int("gyro_video_check/stride", &c.stride, 1, 100);
-  r.Int("gyro_video_check/track_width", &c.track_width, 64, 4096);
-  r.Int("gyro_video_check/max_features", &c.max_features, 8, 2000);
-  r.Num("gyro_video_check/max_fb_error", &c.max_fb_error_px, 1e-3, 10.0);
-  r.Num("gyro_video_check/window", &c.window_s, 0.5, 60.0);
-  r.Num("gyro_video_check/offset_range", &c.offset_range_s, 0.0, 0.5);
-  r.Num("gyro_video_check/offset_step", &c.offset_step_s, 0.0005, 0.1);
-  r.Int("gyro_video_check/min_pairs", &c.min_pairs, 2, 100000);
-  r.Num("gyro_video_check/min_motion", &c.min_motion_px, 0.0, 1000.0);
-  r.Num("gyro_video_check/better_mounting_ratio", &c.better_mounting_ratio, 0.01, 0.99);
-  r.Num("gyro_video_check/offset_warn", &c.offset_warn_s, 1e-4, 1.0);
-  r.Bool("gyro_video_check/apply_offset", &c.apply_offset);
-  r.Num("gyro_video_check/apply_rate", &c.apply_rate_s_per_s, 1e-5, 1.0);
-  Status st = r.status();
+  r.Num("face/dlib_threshold", &f->detector.dlib_threshold);
+  r.Int("face/min_face_px", &f->detector.min_face_px);
+  r.Path("face/landmark_model", &f->landmark_model_path);
+  r.Int("face/redetect_every", &f->redetect_every_frames);
+  r.Num("face/redetect_region_scale", &f->redetect_region_scale);
+  r.Int("face/redetect_face_px", &f->redetect_face_px);
+  r.Num("face/lost_timeout", &f->lost_timeout_s);
+  r.Num("face/search_interval", &f->search_interval_s);
+  r.Num("face/max_shape_residual", &f->max_shape_residual);
+  r.Num("face/min_spread_ratio", &f->min_spread_ratio);
+  r.Num("face/max_spread_ratio", &f->max_spread_ratio);
+  r.Num("face/max_jump", &f->max_jump);
+  r.Num("face/min_appearance", &f->min_appearance);
+  r.Bool("face/estimate_head_pose", &f->estimate_head_pose);
+}
+
+void ReadObjective(Reader& r, steadiface::StabilizerOptions* s) {
+  r.Num("head/w_stay", &s->head.w_stay);
+  r.Num("head/w_follow", &s->head.w_follow);
+  r.Num("head/d_ref", &s->head.d_ref);
+  r.Num("weights/fit", &s->weights.fit);
+  r.Num("weights/distortion", &s->weights.distortion);
+  r.Num("weights/follow", &s->weights.follow);
+  r.Num("weights/rotation_c0", &s->weights.rotation_c0);
+  r.Num("weights/rotation_c1", &s->weights.rotation_c1);
+  r.Num("weights/translation_c0", &s->weights.translation_c0);
+  r.Num("weights/translation_c1", &s->weights.translation_c1);
+  r.Num("weights/protrusion", &s->weights.protrusion);
+  r.Num("terms/distortion_threshold", &s->terms.distortion_threshold_rad);
+  r.Num("terms/distortion_slope", &s->terms.distortion_slope);
+  r.Num("terms/protrusion_alpha", &s->terms.protrusion_alpha);
+  r.Num("terms/protrusion_shrink", &s->terms.protrusion_shrink);
+  r.Int("terms/protrusion_samples_per_edge", &s->terms.protrusion_samples_per_edge);
+}
+
+void ReadDynamicWeights(Reader& r, steadiface::DynamicWeightOptions* d) {
+  r.Bool("dynamic/enabled", &d->enabled);
+  r.Num("dynamic/fade_time", &d->fade_time_s);
+  r.Num("dynamic/gyro_window", &d->gyro_window_s);
+  r.Num("dynamic/gyro_still", &d->gyro_still_rad_s);
+  r.Num("dynamic/gyro_active", &d->gyro_active_rad_s);
+  r.Num("dynamic/gyro_still_fit_scale", &d->gyro_still_fit_scale);
+  r.Num("dynamic/pose_low", &d->pose_low_rad);
+  r.Num("dynamic/pose_high", &d->pose_high_rad);
+  r.Num("dynamic/pose_min_fit_scale", &d->pose_min_fit_scale);
+  r.Num("dynamic/pose_smoothness_boost", &d->pose_smoothness_boost);
+  r.Int("dynamic/variation_window", &d->variation_window);
+  r.Num("dynamic/centre_variation_low", &d->centre_variation_low);
+  r.Num("dynamic/centre_variation_high", &d->centre_variation_high);
+  r.Num("dynamic/scale_variation_low", &d->scale_variation_low);
+  r.Num("dynamic/scale_variation_high", &d->scale_variation_high);
+  r.Num("dynamic/variation_min_fit_scale", &d->variation_min_fit_scale);
+}
+
+void ReadSolverAndStabilizer(Reader& r, steadiface::StabilizerOptions* s) {
+  r.Int("solver/max_iterations", &s->solver.max_iterations);
+  r.Num("solver/function_tolerance", &s->solver.function_tolerance);
+  r.Num("solver/max_time", &s->solver.max_time_s);
+  r.Int("stabilizer/protrusion_search_steps", &s->protrusion_search_steps);
+  r.Int("stabilizer/row_rotation_samples", &s->row_rotation_samples);
+  r.Num("stabilizer/min_face_confidence", &s->min_face_confidence);
+  r.Bool("stabilizer/gyro_only", &s->gyro_only);
+  r.Bool("stabilizer/background_layer", &s->background_layer);
+  r.Bool("stabilizer/smooth_head_in_virtual_view", &s->smooth_head_in_virtual_view);
+  r.Num("stabilizer/intentional_window", &s->intentional_window_s);
+  r.Num("stabilizer/subject_reach", &s->subject_reach);
+}
+
+void ReadOutputAndWarp(Reader& r, steadiface::WarpOptions* w) {
+  r.Num("output/crop_ratio", &w->output.crop_ratio);
+  r.Int("output/width", &w->output.width);
+  r.Int("output/height", &w->output.height);
+  r.Int("warp/mesh_cols", &w->mesh_cols);
+  r.Int("warp/mesh_rows", &w->mesh_rows);
+  r.Int("warp/num_threads", &w->num_threads);
+  r.Bool("warp/fixed_point_maps", &w->fixed_point_maps);
+  std::string mode = steadiface::WarpModeName(w->mode);
+  r.Choice("warp/mode", &mode);
+  const Status ms = steadiface::ParseWarpMode(mode, &w->mode);
+  if (!ms.ok()) r.Error("parameter 'warp/mode': " + ms.message());
+}
+
+void ReadLayered(Reader& r, steadiface::LayeredWarpOptions* lw) {
+  r.Int("warp/layered/mesh_cols", &lw->mesh_cols);
+  r.Int("warp/layered/mesh_rows", &lw->mesh_rows);
+  r.Num("warp/layered/band_width", &lw->blend.band_width);
+  r.Num("warp/layered/band_inside", &lw->blend.band_inside);
+  r.Num("warp/layered/outline_margin", &lw->blend.outline_margin_cells);
+  r.Num("warp/layered/max_offset", &lw->blend.max_offset);
+  r.Num("warp/layered/offset_lowpass", &lw->blend.offset_lowpass_hz);
+  r.Num("warp/layered/band_data_weight", &lw->blend.band_data_weight);
+  r.Num("warp/layered/shape_weight", &lw->blend.shape_weight);
+  r.Num("warp/layered/temporal_weight", &lw->blend.temporal_weight);
+  r.Num("warp/layered/min_cell_ratio", &lw->blend.min_cell_ratio);
+  r.Bool("warp/layered/yield_to_subject", &lw->blend.yield_to_subject);
+  r.Num("warp/layered/head_width_scale", &lw->region.head_width_scale);
+  r.Num("warp/layered/head_top_scale", &lw->region.head_top_scale);
+  r.Bool("warp/layered/torso", &lw->region.torso);
+  r.Num("warp/layered/shoulder_width_scale", &lw->region.shoulder_width_scale);
+  r.Num("warp/layered/neck_width_scale", &lw->region.neck_width_scale);
+  r.Num("warp/layered/region_smoothing", &lw->region.smoothing_s);
+  r.Num("warp/layered/ramp", &lw->region.ramp_s);
+}
+
+void ReadGyroVideoCheck(Reader& r, steadiface::GyroVideoCheckOptions* c) {
+  r.Bool("gyro_video_check/enabled", &c->enabled);
+  r.Int("gyro_video_check/stride", &c->stride);
+  r.Int("gyro_video_check/track_width", &c->track_width);
+  r.Int("gyro_video_check/max_features", &c->max_features);
+  r.Num("gyro_video_check/max_fb_error", &c->max_fb_error_px);
+  r.Num("gyro_video_check/window", &c->window_s);
+  r.Num("gyro_video_check/offset_range", &c->offset_range_s);
+  r.Num("gyro_video_check/offset_step", &c->offset_step_s);
+  r.Int("gyro_video_check/min_pairs", &c->min_pairs);
+  r.Num("gyro_video_check/min_motion", &c->min_motion_px);
+  r.Num("gyro_video_check/better_mounting_ratio", &c->better_mounting_ratio);
+  r.Num("gyro_video_check/offset_warn", &c->offset_warn_s);
+  r.Bool("gyro_video_check/apply_offset", &c->apply_offset);
+  r.Num("gyro_video_check/apply_rate", &c->apply_rate_s_per_s);
+}
+
+}  // namespace
+
+const std::vector<ParameterSpec>& ParameterTable() { return Table(); }
+
+Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
+                   WrapperOptions* wo) {
+  Reader r(params);
+  ReadRosLayer(r, po, wo);
+  ReadCamera(r, po);
+  ReadImu(r, &po->imu);
+  ReadFace(r, &po->face);
+  ReadObjective(r, &po->stabilizer);
+  ReadDynamicWeights(r, &po->stabilizer.dynamic);
+  ReadSolverAndStabilizer(r, &po->stabilizer);
+  ReadOutputAndWarp(r, &po->warp);
+  ReadLayered(r, &po->warp.layered);
+  ReadGyroVideoCheck(r, &po->gyro_video_check);
+  const Status st = r.status();
   if (!st.ok()) return st;
   // Cross-field checks of the core (e.g. low < high) with its own messages.
-  return ValidatePipelineOptions(*po);
+  return steadiface::ValidatePipelineOptions(*po);
 }
 
 void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::StabilizerOptions* o) {

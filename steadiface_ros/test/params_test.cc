@@ -3,9 +3,12 @@
 // LoadOptions rejects bad values with a message naming the key.
 #include "steadiface_ros/params.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include <dynamic_reconfigure/Config.h>
@@ -167,6 +170,122 @@ TEST(ParamsTest, ReconfigureSwitchesTheWarpMode) {
   c.warp_mode = "sideways";  // not a mode: left as it was
   ApplyConfig(c, &mode, &layered);
   EXPECT_EQ(mode, steadiface::WarpMode::kLayered);
+}
+
+// Reads through another source and records every key asked for.
+class KeyRecorder : public ParamSource {
+ public:
+  explicit KeyRecorder(const ParamSource& inner) : inner_(inner) {}
+  bool Get(const std::string& k, double* v) const override { return Note(k, v); }
+  bool Get(const std::string& k, int* v) const override { return Note(k, v); }
+  bool Get(const std::string& k, bool* v) const override { return Note(k, v); }
+  bool Get(const std::string& k, std::string* v) const override { return Note(k, v); }
+  bool Get(const std::string& k, std::vector<double>* v) const override { return Note(k, v); }
+  const std::set<std::string>& keys() const { return keys_; }
+
+ private:
+  template <typename T>
+  bool Note(const std::string& k, T* v) const {
+    keys_.insert(k);
+    return inner_.Get(k, v);
+  }
+  const ParamSource& inner_;
+  mutable std::set<std::string> keys_;
+};
+
+TEST(ParamsTest, LoadOptionsReadsExactlyTheTablesKeys) {
+  std::unique_ptr<ParamSource> yaml;
+  ASSERT_TRUE(YamlParams({kDefaultYaml}, &yaml).ok());
+  KeyRecorder recorder(*yaml);
+  steadiface::PipelineOptions po;
+  WrapperOptions wo;
+  const steadiface::Status s = LoadOptions(recorder, &po, &wo);
+  ASSERT_TRUE(s.ok()) << s.message();  // every key read is in the table, with its type
+  std::set<std::string> table;
+  for (const ParameterSpec& p : ParameterTable()) {
+    if (p.read_by_node) table.insert(p.key);
+  }
+  EXPECT_GT(table.size(), 120u);
+  EXPECT_EQ(recorder.keys(), table);
+}
+
+TEST(ParamsTest, ReconfigureRangesAndNamesAreTheTables) {
+  dynamic_reconfigure::Config lo, hi, def;
+  steadiface::SteadifaceConfig::__getMin__().__toMessage__(lo);
+  steadiface::SteadifaceConfig::__getMax__().__toMessage__(hi);
+  steadiface::SteadifaceConfig::__getDefault__().__toMessage__(def);
+  std::map<std::string, std::pair<double, double>> cfg;
+  for (size_t i = 0; i < lo.doubles.size(); ++i) {
+    cfg[lo.doubles[i].name] = {lo.doubles[i].value, hi.doubles[i].value};
+  }
+  for (size_t i = 0; i < lo.ints.size(); ++i) cfg[lo.ints[i].name] = {lo.ints[i].value, hi.ints[i].value};
+  size_t dynamic = 0;
+  for (const ParameterSpec& p : ParameterTable()) {
+    if (std::string(p.dynamic_name).empty()) continue;
+    ++dynamic;
+    if (p.type != ParameterType::kDouble && p.type != ParameterType::kInt) continue;
+    ASSERT_EQ(cfg.count(p.dynamic_name), 1u) << p.dynamic_name;
+    EXPECT_EQ(cfg[p.dynamic_name].first, p.min) << p.key;
+    EXPECT_EQ(cfg[p.dynamic_name].second, p.max) << p.key;
+  }
+  EXPECT_EQ(dynamic, def.doubles.size() + def.ints.size() + def.bools.size() + def.strs.size());
+}
+
+// Both directions of the reconfigure <-> options map cover every run-time
+// parameter: a value set in the config survives ApplyConfig and
+// ConfigFromOptions, for each parameter at once (distinct, valid values).
+TEST(ParamsTest, EveryReconfigureParameterReachesTheOptionsAndBack) {
+  dynamic_reconfigure::Config lo, hi, msg;
+  steadiface::SteadifaceConfig::__getMin__().__toMessage__(lo);
+  steadiface::SteadifaceConfig::__getMax__().__toMessage__(hi);
+  steadiface::SteadifaceConfig::__getDefault__().__toMessage__(msg);
+  for (size_t i = 0; i < msg.doubles.size(); ++i) {
+    const double span = std::min(hi.doubles[i].value - lo.doubles[i].value, 1e4);
+    msg.doubles[i].value = lo.doubles[i].value + 0.37 * span;
+  }
+  for (size_t i = 0; i < msg.ints.size(); ++i) msg.ints[i].value = lo.ints[i].value + 1;
+  for (auto& b : msg.bools) b.value = !b.value;
+  for (auto& s : msg.strs) s.value = s.value == "global" ? "layered" : "global";
+  steadiface::SteadifaceConfig c = steadiface::SteadifaceConfig::__getDefault__();
+  ASSERT_TRUE(c.__fromMessage__(msg));
+  steadiface::StabilizerOptions o;
+  steadiface::WarpOptions w;
+  ApplyConfig(c, &o);
+  ApplyConfig(c, &w.mode, &w.layered);
+  dynamic_reconfigure::Config back;
+  ConfigFromOptions(o, w).__toMessage__(back);
+  ASSERT_EQ(back.doubles.size(), msg.doubles.size());
+  for (size_t i = 0; i < msg.doubles.size(); ++i) {
+    EXPECT_DOUBLE_EQ(back.doubles[i].value, msg.doubles[i].value) << msg.doubles[i].name;
+  }
+  for (size_t i = 0; i < msg.ints.size(); ++i) {
+    EXPECT_EQ(back.ints[i].value, msg.ints[i].value) << msg.ints[i].name;
+  }
+  for (size_t i = 0; i < msg.bools.size(); ++i) {
+    EXPECT_EQ(back.bools[i].value, msg.bools[i].value) << msg.bools[i].name;
+  }
+  for (size_t i = 0; i < msg.strs.size(); ++i) {
+    EXPECT_EQ(back.strs[i].value, msg.strs[i].value) << msg.strs[i].name;
+  }
+}
+
+TEST(ParamsTest, AChoiceOutsideTheTablesNamesTheChoices) {
+  const std::string path = ::testing::TempDir() + "steadiface_params_choice.yaml";
+  std::ofstream(path) << "late_frame_policy: wait\n";
+  std::unique_ptr<ParamSource> yaml;
+  ASSERT_TRUE(YamlParams({kDefaultYaml, path}, &yaml).ok());
+  steadiface::PipelineOptions po;
+  WrapperOptions wo;
+  const steadiface::Status s = LoadOptions(*yaml, &po, &wo);
+  EXPECT_FALSE(s.ok());
+  EXPECT_EQ(s.message(),
+            "parameter 'late_frame_policy' must be one of extrapolate | drop, got 'wait'");
+  std::ofstream(path) << "late_frame_policy: drop\ncamera:\n  stamp: middle_row\n";
+  ASSERT_TRUE(YamlParams({kDefaultYaml, path}, &yaml).ok());
+  ASSERT_TRUE(LoadOptions(*yaml, &po, &wo).ok());
+  EXPECT_EQ(wo.scheduler.late_frame_policy, steadiface::LateFramePolicy::kDrop);
+  EXPECT_EQ(po.shutter.stamp, steadiface::StampConvention::kMiddleRow);
+  std::remove(path.c_str());
 }
 
 TEST(ParamsTest, AnOutOfRangeValueNamesItsKey) {

@@ -3,8 +3,9 @@
 own (not through the generator): every key of config/default.yaml has a row
 with its default, every dynamic_reconfigure parameter of
 config/Steadiface.cfg appears as a run-time name on the row of a key whose
-default is the .cfg's, and the file is what scripts/dev/gen_parameters_doc.py
-writes today.
+default is the .cfg's, and every generated file (default.yaml, Steadiface.cfg,
+parameter_table.inc, this doc) is what scripts/dev/gen_parameters.py writes
+from config/parameters.yaml today.
 
 usage: parameters_doc_test.py [--junit FILE]
 """
@@ -13,6 +14,7 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 import unittest
 
 import yaml
@@ -104,11 +106,32 @@ class ParametersDocTest(unittest.TestCase):
         self.assertIn("head/w_stay: the doc says 20000.0, default.yaml 5000.0", bad)
         self.assertIn("head_w_stay (head/w_stay): the doc says 20000.0, Steadiface.cfg 5000.0", bad)
 
-    def test_the_doc_is_what_the_generator_writes(self):
-        r = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "dev", "gen_parameters_doc.py"),
+    def test_every_generated_file_is_what_the_table_says(self):
+        r = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "dev", "gen_parameters.py"),
                             "--check"], capture_output=True, text=True)
         self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
 
+    def test_a_bad_row_is_refused_and_a_change_reaches_every_file(self):
+        sys.path.insert(0, os.path.join(REPO, "scripts", "dev"))
+        import gen_parameters as g
+        sections = g.load_table()
+        before = g.render_all(sections)
+        row = next(e for s in sections for e in s["keys"] if e["key"] == "weights/fit")
+        row["max"] = 5.0  # the default (100) would lie outside the range
+        with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
+            yaml.safe_dump(sections, f)
+        try:
+            with self.assertRaises(SystemExit):
+                g.load_table(f.name)
+        finally:
+            os.remove(f.name)
+        row["max"] = 1.0e7  # a valid change: the range reaches the node, the .cfg and the doc
+        after = g.render_all(sections)
+        for name in ("cfg", "inc", "doc"):
+            self.assertNotEqual(before[name], after[name], name)
+        self.assertIn('"weights/fit", ParameterType::kDouble, 0.0, 10000000.0', after["inc"])
+        self.assertIn('"w_fit", double_t, 0', after["cfg"])
+        self.assertIn("100.0, 0.0, 10000000.0)", after["cfg"])
 
 if __name__ == "__main__":
     sys.exit(run_main(ParametersDocTest, "parameters_doc"))

@@ -68,8 +68,23 @@ struct WrapperOptions {
   bool pipelined = false;
 };
 
-/// Loads every option, validating each; errors name the key and its valid
-/// range.
+/// One row of the parameter table (config/parameters.yaml, the one place
+/// that states each key's type, range, choices and dynamic_reconfigure
+/// name; scripts/dev/gen_parameters.py writes it into the build).
+enum class ParameterType { kDouble, kInt, kBool, kString, kList };
+struct ParameterSpec {
+  const char* key;           ///< '/'-separated path in the private namespace
+  ParameterType type;
+  double min, max;           ///< numbers: the valid range (inclusive)
+  const char* choices;       ///< strings: '|'-separated valid values ("" = any)
+  const char* dynamic_name;  ///< its dynamic_reconfigure name ("" = none)
+  bool read_by_node;         ///< false: only the launch files read it
+};
+/// Every key, in the table's order.
+const std::vector<ParameterSpec>& ParameterTable();
+
+/// Loads every option, validating each against the parameter table; errors
+/// name the key and its valid range or choices.
 steadiface::Status LoadOptions(const ParamSource& params,
                                steadiface::PipelineOptions* pipeline,
                                WrapperOptions* wrapper);
