@@ -124,11 +124,11 @@ int BayerToBgrCode(const std::string& e) {
   return cv::COLOR_BayerGB2BGR;  // GRBG
 }
 
-}  // namespace
-
-steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
+// The message's size, encoding, step and data checked; its pixel layout
+// into *channels and *depth. Float and signed images are refused.
+steadiface::Status CheckImageLayout(const sensor_msgs::Image& msg, int* channels_out,
+                                    int* depth_out) {
   using steadiface::Status;
-  namespace enc = sensor_msgs::image_encodings;
   if (msg.width == 0 || msg.height == 0) {
     return Status::Error("image: zero size (" + std::to_string(msg.width) + "x" +
                          std::to_string(msg.height) + ")");
@@ -165,6 +165,54 @@ steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
   if (bigendian_mismatch) {
     return Status::Error("image: big-endian " + e + " is not supported (is_bigendian set)");
   }
+  *channels_out = channels;
+  *depth_out = depth;
+  return Status::Ok();
+}
+
+// Bayer (8 or 16 bits) demosaiced to BGR8; the colour is there, so not to grey.
+steadiface::Status ConvertBayer(const sensor_msgs::Image& msg, int depth, uint8_t* data,
+                                cv::Mat* image) {
+  using steadiface::Status;
+  if (msg.width < 2 || msg.height < 2) return Status::Error("image: bayer image below 2x2");
+  const cv::Mat src(msg.height, msg.width, depth == 16 ? CV_16UC1 : CV_8UC1, data, msg.step);
+  cv::Mat bgr;
+  cv::cvtColor(src, bgr, BayerToBgrCode(msg.encoding));
+  if (depth == 16) {
+    bgr.convertTo(*image, CV_8U, 255.0 / 65535.0);
+  } else {
+    *image = bgr;
+  }
+  return Status::Ok();
+}
+
+// mono16, 16UC1, bgr16, rgb16, ...: the full 16-bit range to 8 bits, BGR order.
+void Convert16(const sensor_msgs::Image& msg, int channels, uint8_t* data, cv::Mat* image) {
+  namespace enc = sensor_msgs::image_encodings;
+  const std::string& e = msg.encoding;
+  const cv::Mat src(msg.height, msg.width, CV_MAKETYPE(CV_16U, channels), data, msg.step);
+  cv::Mat scaled;
+  src.convertTo(scaled, CV_8U, 255.0 / 65535.0);
+  if (channels == 1) {
+    *image = scaled;
+  } else if (e == enc::RGB16 || e == enc::RGBA16) {
+    cv::cvtColor(scaled, *image, channels == 3 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGR);
+  } else if (channels == 3) {
+    *image = scaled;
+  } else {
+    cv::cvtColor(scaled, *image, cv::COLOR_BGRA2BGR);
+  }
+}
+
+}  // namespace
+
+steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
+  using steadiface::Status;
+  namespace enc = sensor_msgs::image_encodings;
+  int channels = 0, depth = 0;
+  const Status layout = CheckImageLayout(msg, &channels, &depth);
+  if (!layout.ok()) return layout;
+  const std::string& e = msg.encoding;
   uint8_t* data = const_cast<uint8_t*>(msg.data.data());  // never written to
   if (e == enc::MONO8 || e == enc::BGR8 || e == enc::BGRA8 || e == enc::TYPE_8UC1 ||
       e == enc::TYPE_8UC3 || e == enc::TYPE_8UC4) {
@@ -187,33 +235,9 @@ steadiface::Status ToCvImage(const sensor_msgs::Image& msg, cv::Mat* image) {
       cv::cvtColor(src, *image, uyvy ? cv::COLOR_YUV2BGR_UYVY : cv::COLOR_YUV2BGR_YUYV);
       return Status::Ok();
     }
-    if (enc::isBayer(e)) {
-      // Demosaiced to colour (not to grey: the colour is there).
-      if (msg.width < 2 || msg.height < 2) return Status::Error("image: bayer image below 2x2");
-      const cv::Mat src(msg.height, msg.width, depth == 16 ? CV_16UC1 : CV_8UC1, data, msg.step);
-      cv::Mat bgr;
-      cv::cvtColor(src, bgr, BayerToBgrCode(e));
-      if (depth == 16) {
-        bgr.convertTo(*image, CV_8U, 255.0 / 65535.0);
-      } else {
-        *image = bgr;
-      }
-      return Status::Ok();
-    }
+    if (enc::isBayer(e)) return ConvertBayer(msg, depth, data, image);
     if (depth == 16 && (channels == 1 || channels == 3 || channels == 4)) {
-      // mono16, 16UC1, bgr16, rgb16, ...: full 16-bit range -> 8 bits.
-      const cv::Mat src(msg.height, msg.width, CV_MAKETYPE(CV_16U, channels), data, msg.step);
-      cv::Mat scaled;
-      src.convertTo(scaled, CV_8U, 255.0 / 65535.0);
-      if (channels == 1) {
-        *image = scaled;
-      } else if (e == enc::RGB16 || e == enc::RGBA16) {
-        cv::cvtColor(scaled, *image, channels == 3 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGR);
-      } else if (channels == 3) {
-        *image = scaled;
-      } else {
-        cv::cvtColor(scaled, *image, cv::COLOR_BGRA2BGR);
-      }
+      Convert16(msg, channels, data, image);
       return Status::Ok();
     }
     // What is left (8UC2, 16UC2: two channels that are not a named 4:2:2

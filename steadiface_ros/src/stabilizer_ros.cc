@@ -10,13 +10,39 @@ namespace steadiface_ros {
 
 StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std::string& name)
     : nh_(nh), pnh_(pnh), name_(name) {
-  // 1. Parameters.
+  // 1. Parameters (and the stream wrapper built from them).
+  if (!LoadParameters()) return;
+  // 2. dynamic_reconfigure, with its own mutex; starts from the loaded options.
+  StartReconfigure();
+  // 3. Publishers and diagnostics.
+  Advertise();
+  StartDiagnostics();
+  // 4. Subscribers: IMU never lazy, with a large queue.
+  bool builtin_compressed = false;
+  const std::string transport = Subscribe(&builtin_compressed);
+  timer_ = nh_.createTimer(ros::Duration(0.01), &StabilizerRos::OnTimer, this);
+  last_imu_wall_ = ros::WallTime::now();
+  ok_ = true;
+  const std::string intrinsics = info_source_->has_file_info()
+                                     ? "camera_info or " + info_source_->url()
+                                     : std::string("camera_info");
+  ROS_INFO("[%s] ready: image_raw (%s%s) + %s -> image_stabilized, imu, landmark source %s",
+           name_.c_str(), transport.c_str(), builtin_compressed ? ", built-in decoder" : "",
+           intrinsics.c_str(),
+           pipeline_options_.landmark_source == steadiface::LandmarkSource::kDlib
+               ? "dlib"
+               : pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal
+                     ? "topic"
+                     : "none");
+}
+
+bool StabilizerRos::LoadParameters() {
   std::unique_ptr<ParamSource> params = RosParams(pnh_);
   const steadiface::Status s = LoadOptions(*params, &pipeline_options_, &wrapper_options_);
   if (!s.ok()) {
     ROS_ERROR("[%s] invalid parameters, the stabilizer will not run: %s", name_.c_str(),
               s.message().c_str());
-    return;
+    return false;
   }
   info_source_.reset(new CameraInfoSource([this](bool is_error, const std::string& text) {
     if (is_error) {
@@ -29,7 +55,7 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   if (!info_status.ok()) {
     ROS_ERROR("[%s] invalid camera_info_url, the stabilizer will not run: %s", name_.c_str(),
               info_status.message().c_str());
-    return;
+    return false;
   }
   tf_buffer_.reset(new tf2_ros::Buffer);
   tf_listener_.reset(new tf2_ros::TransformListener(*tf_buffer_, nh_));
@@ -39,7 +65,10 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
         return LookupExtrinsic(a, b, q);
       }));
 
-  // 2. dynamic_reconfigure, with its own mutex; starts from the loaded options.
+  return true;
+}
+
+void StabilizerRos::StartReconfigure() {
   reconfigure_.reset(
       new dynamic_reconfigure::Server<steadiface::SteadifaceConfig>(reconfigure_mutex_, pnh_));
   {
@@ -48,8 +77,9 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   }
   reconfigure_->setCallback(
       [this](steadiface::SteadifaceConfig& c, uint32_t level) { OnReconfigure(c, level); });
+}
 
-  // 3. Publishers.
+void StabilizerRos::Advertise() {
   it_.reset(new image_transport::ImageTransport(nh_));
   // Its own camera namespace, so its camera_info does not collide with the
   // input's: image_stabilized/image_raw + image_stabilized/camera_info.
@@ -59,8 +89,9 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   state_pub_ = nh_.advertise<steadiface::StabilizerState>("state", 10);
   head_target_pub_ = nh_.advertise<geometry_msgs::PointStamped>("head_target", 10);
   frusta_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("frusta", 2);
+}
 
-  // Diagnostics.
+void StabilizerRos::StartDiagnostics() {
   updater_.reset(new diagnostic_updater::Updater(nh_, pnh_, name_));
   updater_->setHardwareID("steadiface");
   if (wrapper_options_.expected_image_rate > 0) {
@@ -85,8 +116,11 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   updater_->add("frames", this, &StabilizerRos::DiagFrames);
   updater_->add("protrusion", this, &StabilizerRos::DiagProtrusion);
   updater_->add("gyro vs video", this, &StabilizerRos::DiagGyroVideo);
+}
 
-  // 4. Subscribers: IMU never lazy, with a large queue.
+// Subscribes the inputs; returns the image transport in use (and whether
+// the built-in jpeg/png decoder serves "compressed").
+std::string StabilizerRos::Subscribe(bool* builtin_compressed_out) {
   imu_sub_ = nh_.subscribe("imu", 2000, &StabilizerRos::OnImu, this,
                            ros::TransportHints().tcpNoDelay());
   // ~image_transport (raw | compressed | ...), read from this node's private
@@ -126,20 +160,8 @@ StabilizerRos::StabilizerRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std:
   if (pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal) {
     landmarks_sub_ = nh_.subscribe("landmarks_in", 10, &StabilizerRos::OnLandmarks, this);
   }
-  timer_ = nh_.createTimer(ros::Duration(0.01), &StabilizerRos::OnTimer, this);
-  last_imu_wall_ = ros::WallTime::now();
-  ok_ = true;
-  const std::string intrinsics = info_source_->has_file_info()
-                                     ? "camera_info or " + info_source_->url()
-                                     : std::string("camera_info");
-  ROS_INFO("[%s] ready: image_raw (%s%s) + %s -> image_stabilized, imu, landmark source %s",
-           name_.c_str(), transport.c_str(), builtin_compressed ? ", built-in decoder" : "",
-           intrinsics.c_str(),
-           pipeline_options_.landmark_source == steadiface::LandmarkSource::kDlib
-               ? "dlib"
-               : pipeline_options_.landmark_source == steadiface::LandmarkSource::kExternal
-                     ? "topic"
-                     : "none");
+  *builtin_compressed_out = builtin_compressed;
+  return transport;
 }
 
 StabilizerRos::~StabilizerRos() {

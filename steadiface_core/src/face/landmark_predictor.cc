@@ -71,75 +71,71 @@ void LandmarkPredictor::Impl::Pack() {
 LandmarkPredictor::LandmarkPredictor() = default;
 LandmarkPredictor::~LandmarkPredictor() = default;
 
-Status LandmarkPredictor::Load(const std::string& path,
-                               std::unique_ptr<LandmarkPredictor>* out,
-                               const std::string& cache_dir) {
-  const std::string hint =
-      " (a one-time step that rosdep cannot do: on Debian or Ubuntu, "
-      "'sudo apt-get install libdlib-data' puts the default model at "
-      "/usr/share/dlib/shape_predictor_68_face_landmarks.dat; elsewhere, "
-      "download shape_predictor_68_face_landmarks.dat.bz2 from dlib.net/files, "
-      "bunzip2 it and set face/landmark_model to its path; "
-      "or set landmark_source to 'none' for gyro-only stabilization)";
-  std::ifstream probe(path, std::ios::binary);
-  if (!probe.good()) {
-    return Status::Error("landmark model '" + path + "' cannot be opened" +
-                         hint);
-  }
-  probe.close();
-  static std::mutex cache_mutex;
-  static std::map<std::string, std::weak_ptr<const Impl>> cache;
-  {
-    std::lock_guard<std::mutex> lock(cache_mutex);
-    auto it = cache.find(path);
-    if (it != cache.end()) {
-      if (std::shared_ptr<const Impl> shared = it->second.lock()) {
-        std::unique_ptr<LandmarkPredictor> p(new LandmarkPredictor);
-        p->impl_ = shared;
-        *out = std::move(p);
-        return Status::Ok();
-      }
-    }
-  }
-  std::unique_ptr<LandmarkPredictor> p(new LandmarkPredictor);
+namespace {
+
+using Impl = LandmarkPredictor::Impl;
+
+constexpr char kModelHint[] =
+    " (a one-time step that rosdep cannot do: on Debian or Ubuntu, "
+    "'sudo apt-get install libdlib-data' puts the default model at "
+    "/usr/share/dlib/shape_predictor_68_face_landmarks.dat; elsewhere, "
+    "download shape_predictor_68_face_landmarks.dat.bz2 from dlib.net/files, "
+    "bunzip2 it and set face/landmark_model to its path; "
+    "or set landmark_source to 'none' for gyro-only stabilization)";
+
+// Models this process has loaded, by path (shared while any predictor
+// holds one).
+struct ProcessCache {
+  std::mutex mutex;
+  std::map<std::string, std::weak_ptr<const Impl>> models;
+};
+ProcessCache& Loaded() {
+  static ProcessCache cache;
+  return cache;
+}
+
+std::shared_ptr<const Impl> FindLoaded(const std::string& path) {
+  ProcessCache& c = Loaded();
+  std::lock_guard<std::mutex> lock(c.mutex);
+  const auto it = c.models.find(path);
+  return it == c.models.end() ? nullptr : it->second.lock();
+}
+
+void RememberLoaded(const std::string& path, const std::shared_ptr<const Impl>& model) {
+  ProcessCache& c = Loaded();
+  std::lock_guard<std::mutex> lock(c.mutex);
+  c.models[path] = model;
+}
+
+bool Consistent(const Impl& m) {
+  return m.num_parts() == 68 && m.forests.size() == m.anchor_idx.size() &&
+         m.forests.size() == m.deltas.size();
+}
+
+// The model from the disk cache: the packed form, else dlib's structures
+// (packed and rewritten as the packed form). Null when neither is usable.
+std::shared_ptr<Impl> FromDiskCache(const std::string& cache_dir, const std::string& cache_file,
+                                    const LandmarkModelKey& key, bool* packed_from_cache) {
   auto impl = std::make_shared<Impl>();
-  LandmarkModelKey key;
-  const bool cacheable = !cache_dir.empty() && StatLandmarkModel(path, &key);
-  const std::string cache_file =
-      cacheable ? LandmarkCacheFile(cache_dir, key) : std::string();
-  // Every path ends the same way: the predictor takes the model, and the
-  // process remembers it for the next Load of the same file.
-  auto finish = [&](std::shared_ptr<const Impl> model, bool from_cache,
-                    bool packed_from_cache) {
-    {
-      std::lock_guard<std::mutex> lock(cache_mutex);
-      cache[path] = model;
-    }
-    p->impl_ = std::move(model);
-    p->from_cache_ = from_cache;
-    p->packed_from_cache_ = packed_from_cache;
-    *out = std::move(p);
-    return Status::Ok();
-  };
-  if (cacheable && impl->ReadPackedCache(cache_file, key) &&
-      impl->num_parts() == 68 &&
-      impl->forests.size() == impl->anchor_idx.size() &&
-      impl->forests.size() == impl->deltas.size()) {
-    return finish(impl, true, true);
+  if (impl->ReadPackedCache(cache_file, key) && Consistent(*impl)) {
+    *packed_from_cache = true;
+    return impl;
   }
   // No packed cache (a plain one, a damaged one, or none): dlib's structures.
   impl = std::make_shared<Impl>();
-  if (cacheable && impl->ReadCache(cache_file, key) &&
-      impl->num_parts() == 68 && !impl->forests.empty() &&
-      impl->forests.size() == impl->anchor_idx.size() &&
-      impl->forests.size() == impl->deltas.size()) {
+  if (impl->ReadCache(cache_file, key) && Consistent(*impl) && !impl->forests.empty()) {
     impl->Pack();
     // A plain cache of a packable model (as older versions wrote): packed
     // from now on.
     if (impl->packed()) impl->WritePackedCache(cache_dir, cache_file, key);
-    return finish(impl, true, false);
+    *packed_from_cache = false;
+    return impl;
   }
-  impl = std::make_shared<Impl>();
+  return nullptr;
+}
+
+// dlib's own serialization of a 68-point shape predictor.
+Status ReadDlibModel(const std::string& path, Impl* m) {
   try {
     std::ifstream in(path, std::ios::binary);
     int version = 0;
@@ -148,32 +144,64 @@ Status LandmarkPredictor::Load(const std::string& path,
       throw dlib::serialization_error("unexpected shape_predictor version " +
                                       std::to_string(version));
     }
-    Impl& m = *impl;
-    dlib::deserialize(m.initial_shape, in);
-    dlib::deserialize(m.forests, in);
-    dlib::deserialize(m.anchor_idx, in);
-    dlib::deserialize(m.deltas, in);
-    if (m.forests.empty() || m.forests.size() != m.anchor_idx.size() ||
-        m.forests.size() != m.deltas.size()) {
+    dlib::deserialize(m->initial_shape, in);
+    dlib::deserialize(m->forests, in);
+    dlib::deserialize(m->anchor_idx, in);
+    dlib::deserialize(m->deltas, in);
+    if (m->forests.empty() || m->forests.size() != m->anchor_idx.size() ||
+        m->forests.size() != m->deltas.size()) {
       throw dlib::serialization_error("inconsistent cascade sizes");
     }
   } catch (const std::exception& e) {
-    return Status::Error("landmark model '" + path +
-                         "' is not a valid dlib shape predictor (" + e.what() +
-                         ")" + hint);
+    return Status::Error("landmark model '" + path + "' is not a valid dlib shape predictor (" +
+                         e.what() + ")" + kModelHint);
   }
-  if (impl->num_parts() != 68) {
+  if (m->num_parts() != 68) {
     return Status::Error("landmark model '" + path + "' predicts " +
-                         std::to_string(impl->num_parts()) +
-                         " points; steadiface needs the 68-point model" + hint);
+                         std::to_string(m->num_parts()) +
+                         " points; steadiface needs the 68-point model" + kModelHint);
   }
-  impl->Pack();
-  if (cacheable && impl->packed()) {
-    impl->WritePackedCache(cache_dir, cache_file, key);
-  } else if (cacheable) {
-    impl->WriteCache(cache_dir, cache_file, key);  // Pack() left dlib's trees
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status LandmarkPredictor::Load(const std::string& path, std::unique_ptr<LandmarkPredictor>* out,
+                               const std::string& cache_dir) {
+  if (!std::ifstream(path, std::ios::binary).good()) {
+    return Status::Error("landmark model '" + path + "' cannot be opened" + kModelHint);
   }
-  return finish(impl, false, false);
+  std::unique_ptr<LandmarkPredictor> p(new LandmarkPredictor);
+  if (std::shared_ptr<const Impl> shared = FindLoaded(path)) {
+    p->impl_ = shared;
+    *out = std::move(p);
+    return Status::Ok();
+  }
+  LandmarkModelKey key;
+  const bool cacheable = !cache_dir.empty() && StatLandmarkModel(path, &key);
+  const std::string cache_file = cacheable ? LandmarkCacheFile(cache_dir, key) : std::string();
+  bool packed_from_cache = false;
+  std::shared_ptr<Impl> impl =
+      cacheable ? FromDiskCache(cache_dir, cache_file, key, &packed_from_cache) : nullptr;
+  const bool from_cache = impl != nullptr;
+  if (!from_cache) {
+    impl = std::make_shared<Impl>();
+    const Status s = ReadDlibModel(path, impl.get());
+    if (!s.ok()) return s;
+    impl->Pack();
+    if (cacheable && impl->packed()) {
+      impl->WritePackedCache(cache_dir, cache_file, key);
+    } else if (cacheable) {
+      impl->WriteCache(cache_dir, cache_file, key);  // Pack() left dlib's trees
+    }
+  }
+  // The process remembers it for the next Load of the same file.
+  RememberLoaded(path, impl);
+  p->impl_ = std::move(impl);
+  p->from_cache_ = from_cache;
+  p->packed_from_cache_ = packed_from_cache;
+  *out = std::move(p);
+  return Status::Ok();
 }
 
 int LandmarkPredictor::num_parts() const {

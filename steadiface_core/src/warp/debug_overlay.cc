@@ -15,63 +15,51 @@ cv::Point2f P(const Eigen::Vector2d& p) {
   return cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
 }
 
-}  // namespace
+// The landmarks (green dots) and their centre C (yellow cross).
+void DrawFace(const FaceInfo& face, double s, int th, cv::Mat* out) {
+  const cv::Scalar green(0, 220, 0), yellow(0, 230, 255);
+  for (const auto& p : face.landmarks_px) {
+    cv::circle(*out, P(p), static_cast<int>(2 * s), green, cv::FILLED, cv::LINE_AA);
+  }
+  const cv::Point2f c = P(face.centre_px);
+  const float r = static_cast<float>(8 * s);
+  cv::line(*out, c - cv::Point2f(r, 0), c + cv::Point2f(r, 0), yellow, th, cv::LINE_AA);
+  cv::line(*out, c - cv::Point2f(0, r), c + cv::Point2f(0, r), yellow, th, cv::LINE_AA);
+}
 
-void DrawDebugOverlay(const cv::Mat& input, const CameraModel& model,
-                      const ProtrusionGeometry& protrusion,
-                      const FaceInfo* face, const StabilizerFrame* frame,
-                      cv::Mat* out) {
-  if (input.channels() == 1) {
-    cv::cvtColor(input, *out, cv::COLOR_GRAY2BGR);
-  } else if (input.channels() == 4) {
-    cv::cvtColor(input, *out, cv::COLOR_BGRA2BGR);
-  } else {
-    input.copyTo(*out);
+// The crop footprint (the output boundary mapped into the input: cyan, red
+// where it leaves the frame) and H where it falls in the input (magenta).
+void DrawFootprint(const CameraModel& model, const ProtrusionGeometry& protrusion,
+                   const StabilizerFrame& frame, double s, int th, cv::Mat* out) {
+  const cv::Scalar magenta(255, 0, 255), cyan(255, 220, 0), red(0, 0, 255);
+  const CameraIntrinsics& k = model.intrinsics();
+  std::vector<cv::Point2f> poly;
+  std::vector<bool> inside;
+  double row = 0.5 * (k.height - 1);
+  for (const auto& V : protrusion.boundary()) {
+    Eigen::Vector2d p;
+    if (!VirtualToRealPixelRS(model, frame.R_v, frame.t, frame.rows, V, 5, 1e-2, &p, &row)) {
+      continue;
+    }
+    poly.push_back(P(p));
+    inside.push_back(p.x() >= 0 && p.y() >= 0 && p.x() <= k.width - 1 && p.y() <= k.height - 1);
   }
-  const double s = std::max(1.0, out->cols / 640.0);  // line scale
-  const int th = static_cast<int>(std::lround(s));
-  const cv::Scalar green(0, 220, 0), yellow(0, 230, 255), magenta(255, 0, 255),
-      cyan(255, 220, 0), red(0, 0, 255), white(255, 255, 255);
-  if (face != nullptr && face->valid) {
-    for (const auto& p : face->landmarks_px) {
-      cv::circle(*out, P(p), static_cast<int>(2 * s), green, cv::FILLED, cv::LINE_AA);
-    }
-    const cv::Point2f c = P(face->centre_px);
-    const float r = static_cast<float>(8 * s);
-    cv::line(*out, c - cv::Point2f(r, 0), c + cv::Point2f(r, 0), yellow, th, cv::LINE_AA);
-    cv::line(*out, c - cv::Point2f(0, r), c + cv::Point2f(0, r), yellow, th, cv::LINE_AA);
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const size_t j = (i + 1) % poly.size();
+    cv::line(*out, poly[i], poly[j], inside[i] && inside[j] ? cyan : red, th, cv::LINE_AA);
   }
-  if (frame != nullptr && !frame->rows.empty()) {
-    // Crop footprint: the output boundary mapped into the input.
-    const CameraIntrinsics& k = model.intrinsics();
-    std::vector<cv::Point2f> poly;
-    std::vector<bool> inside;
-    double row = 0.5 * (k.height - 1);
-    for (const auto& V : protrusion.boundary()) {
-      Eigen::Vector2d p;
-      if (!VirtualToRealPixelRS(model, frame->R_v, frame->t, frame->rows, V, 5,
-                                1e-2, &p, &row)) {
-        continue;
-      }
-      poly.push_back(P(p));
-      inside.push_back(p.x() >= 0 && p.y() >= 0 && p.x() <= k.width - 1 &&
-                       p.y() <= k.height - 1);
-    }
-    for (size_t i = 0; i < poly.size(); ++i) {
-      const size_t j = (i + 1) % poly.size();
-      cv::line(*out, poly[i], poly[j], inside[i] && inside[j] ? cyan : red, th,
-               cv::LINE_AA);
-    }
-    if (frame->has_target) {
-      // H lives in the virtual view; show where it falls in the input.
-      Eigen::Vector2d h;
-      if (model.Unproject(frame->H, frame->R_v, frame->t, frame->R_r, &h)) {
-        cv::circle(*out, P(model.NormalizedToPixel(h)), static_cast<int>(10 * s),
-                   magenta, th, cv::LINE_AA);
-      }
+  if (frame.has_target) {
+    // H lives in the virtual view; show where it falls in the input.
+    Eigen::Vector2d h;
+    if (model.Unproject(frame.H, frame.R_v, frame.t, frame.R_r, &h)) {
+      cv::circle(*out, P(model.NormalizedToPixel(h)), static_cast<int>(10 * s), magenta, th,
+                 cv::LINE_AA);
     }
   }
-  // Text block.
+}
+
+// The state as text: face tracking, head pose, w_f, the solver and flags.
+std::vector<std::string> StateLines(const FaceInfo* face, const StabilizerFrame* frame) {
   std::vector<std::string> lines;
   char buf[160];
   if (face != nullptr) {
@@ -99,13 +87,34 @@ void DrawDebugOverlay(const cv::Mat& input, const CameraModel& model,
     if (frame->flags.undefined_pixels) flags += " UNDEFINED";
     if (!flags.empty()) lines.push_back("flags:" + flags);
   }
+  return lines;
+}
+
+}  // namespace
+
+void DrawDebugOverlay(const cv::Mat& input, const CameraModel& model,
+                      const ProtrusionGeometry& protrusion,
+                      const FaceInfo* face, const StabilizerFrame* frame,
+                      cv::Mat* out) {
+  if (input.channels() == 1) {
+    cv::cvtColor(input, *out, cv::COLOR_GRAY2BGR);
+  } else if (input.channels() == 4) {
+    cv::cvtColor(input, *out, cv::COLOR_BGRA2BGR);
+  } else {
+    input.copyTo(*out);
+  }
+  const double s = std::max(1.0, out->cols / 640.0);  // line scale
+  const int th = static_cast<int>(std::lround(s));
+  if (face != nullptr && face->valid) DrawFace(*face, s, th, out);
+  if (frame != nullptr && !frame->rows.empty()) DrawFootprint(model, protrusion, *frame, s, th, out);
+  // Text block.
   const double fs = 0.5 * s;
   int y = static_cast<int>(20 * s);
-  for (const auto& l : lines) {
+  for (const auto& l : StateLines(face, frame)) {
     cv::putText(*out, l, cv::Point(static_cast<int>(8 * s), y), cv::FONT_HERSHEY_SIMPLEX,
                 fs, cv::Scalar(0, 0, 0), th + 2, cv::LINE_AA);
     cv::putText(*out, l, cv::Point(static_cast<int>(8 * s), y), cv::FONT_HERSHEY_SIMPLEX,
-                fs, white, th, cv::LINE_AA);
+                fs, cv::Scalar(255, 255, 255), th, cv::LINE_AA);
     y += static_cast<int>(18 * s);
   }
 }

@@ -124,6 +124,88 @@ bool ShuffleSupported() { return cv::checkHardwareSupport(CV_CPU_SSSE3); }
 bool ShuffleSupported() { return true; }
 #endif
 
+namespace {
+
+// The 3-channel kernel's constants and tables, loaded once per segment.
+struct Color3Consts {
+  cv::v_int32x4 m31, m31x64, k32, k32x64, half;
+  cv::v_uint16x8 k255;
+  cv::v_uint8x16 pix_a, pix_b, off_a, off_b, wsel_a, wsel_b, word0, word1, word2, out0, out1,
+      out2;
+};
+
+STEADIFACE_SHUFFLE_TARGET inline Color3Consts LoadColor3Consts() {
+  using namespace cv;
+  Color3Consts k;
+  k.m31 = v_setall_s32(kInterTabSize - 1);
+  // fy, 64 times, from Y in one shift: Y >> (kScanFrac - 6), masked.
+  k.m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
+  k.k32 = v_setall_s32(kInterTabSize);
+  k.k32x64 = v_setall_s32(kInterTabSize << 6);
+  k.k255 = v_setall_u16(255);
+  k.half = v_setall_s32(1 << 15);
+  k.pix_a = v_load(kColor3Shuffle.pair_pixel_byte[0]);
+  k.pix_b = v_load(kColor3Shuffle.pair_pixel_byte[1]);
+  k.off_a = v_load(kColor3Shuffle.pair_offset[0]);
+  k.off_b = v_load(kColor3Shuffle.pair_offset[1]);
+  k.wsel_a = v_load(kColor3Shuffle.pair_weight_byte[0]);
+  k.wsel_b = v_load(kColor3Shuffle.pair_weight_byte[1]);
+  k.word0 = v_load(kColor3Shuffle.pixel_word[0]);
+  k.word1 = v_load(kColor3Shuffle.pixel_word[1]);
+  k.word2 = v_load(kColor3Shuffle.pixel_word[2]);
+  k.out0 = v_load(kColor3Shuffle.output_byte[0]);
+  k.out1 = v_load(kColor3Shuffle.output_byte[1]);
+  k.out2 = v_load(kColor3Shuffle.output_byte[2]);
+  return k;
+}
+
+// One group of 4 pixels at (Xv, Yv) whose sources lie in the row pair at
+// `p` (pixel ix0 of row iy0) within 16 bytes: the 12 output bytes (and 4
+// zero bytes).
+STEADIFACE_SHUFFLE_TARGET inline cv::v_uint8x16 Color3Group(const Color3Consts& k,
+                                                            const uchar* p, size_t step,
+                                                            int ix0, const cv::v_int32x4& Xv,
+                                                            const cv::v_int32x4& Yv) {
+  using namespace cv;
+  constexpr int shift = kScanFrac + kInterBits;
+  const v_uint8x16 top = v_load(p);
+  const v_uint8x16 bottom = v_load(p + step);
+  // Each pixel's byte offset from pixel ix0 (0..9), and its weights, one
+  // 32-bit lane per pixel (adds and 16-bit multiplies rather than shifts:
+  // shifts share the shuffles' ports).
+  const v_int32x4 rel = v_shr<shift>(Xv) - v_setall_s32(ix0);
+  const v_uint8x16 off = v_reinterpret_as_u8(rel + rel + rel);
+  const v_int32x4 fx = v_shr<kScanFrac>(Xv) & k.m31;
+  // Bytes (32 - fx, fx): 32 + 255 fx (fx < 32: the high 16 bits stay 0).
+  const v_uint8x16 wx = v_reinterpret_as_u8(
+      k.k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fx), k.k255)));
+  const v_int32x4 fy64 = v_shr<kScanFrac - 6>(Yv) & k.m31x64;
+  // 16-bit halves (64 (32 - fy), 64 fy).
+  const v_uint8x16 wy = v_reinterpret_as_u8((k.k32x64 - fy64) | v_shl<16>(fy64));
+  // Horizontal step, per row and pair.
+  const v_uint8x16 idx_a = ShuffleBytes(off, k.pix_a) + k.off_a;
+  const v_uint8x16 idx_b = ShuffleBytes(off, k.pix_b) + k.off_b;
+  const v_uint8x16 w_a = ShuffleBytes(wx, k.wsel_a);
+  const v_uint8x16 w_b = ShuffleBytes(wx, k.wsel_b);
+  const v_int16x8 top_a = MulAddPairs(ShuffleBytes(top, idx_a), w_a);
+  const v_int16x8 top_b = MulAddPairs(ShuffleBytes(top, idx_b), w_b);
+  const v_int16x8 bot_a = MulAddPairs(ShuffleBytes(bottom, idx_a), w_a);
+  const v_int16x8 bot_b = MulAddPairs(ShuffleBytes(bottom, idx_b), w_b);
+  // Vertical step: (top, bottom) per pair, P = 0-3, 4-7, 8-11; rounded,
+  // and the result byte picked out.
+  v_int16x8 z0, z1, z2, unused;
+  v_zip(top_a, bot_a, z0, z1);
+  v_zip(top_b, bot_b, z2, unused);
+  const v_int32x4 h0 = v_dotprod(z0, v_reinterpret_as_s16(ShuffleBytes(wy, k.word0))) + k.half;
+  const v_int32x4 h1 = v_dotprod(z1, v_reinterpret_as_s16(ShuffleBytes(wy, k.word1))) + k.half;
+  const v_int32x4 h2 = v_dotprod(z2, v_reinterpret_as_s16(ShuffleBytes(wy, k.word2))) + k.half;
+  return ShuffleBytes(v_reinterpret_as_u8(h0), k.out0) |
+         ShuffleBytes(v_reinterpret_as_u8(h1), k.out1) |
+         ShuffleBytes(v_reinterpret_as_u8(h2), k.out2);
+}
+
+}  // namespace
+
 // A stepped 3-channel segment: shuffle groups where they apply, the
 // portable 4-pixel group or scalar pixels elsewhere (same arithmetic).
 STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
@@ -156,25 +238,7 @@ STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
   const v_int32x4 ramp(0, DX, 2 * DX, 3 * DX);
   const v_int32x4 rampy(0, DY, 2 * DY, 3 * DY);
   const v_int32x4 dx4 = v_setall_s32(4 * DX), dy4 = v_setall_s32(4 * DY);
-  const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
-  // fy, 64 times, from Y in one shift: Y >> (kScanFrac - 6), masked.
-  const v_int32x4 m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
-  const v_int32x4 k32 = v_setall_s32(kInterTabSize);
-  const v_int32x4 k32x64 = v_setall_s32(kInterTabSize << 6);
-  const v_uint16x8 k255 = v_setall_u16(255);
-  const v_int32x4 half = v_setall_s32(1 << 15);
-  const v_uint8x16 pix_a = v_load(kColor3Shuffle.pair_pixel_byte[0]);
-  const v_uint8x16 pix_b = v_load(kColor3Shuffle.pair_pixel_byte[1]);
-  const v_uint8x16 off_a = v_load(kColor3Shuffle.pair_offset[0]);
-  const v_uint8x16 off_b = v_load(kColor3Shuffle.pair_offset[1]);
-  const v_uint8x16 wsel_a = v_load(kColor3Shuffle.pair_weight_byte[0]);
-  const v_uint8x16 wsel_b = v_load(kColor3Shuffle.pair_weight_byte[1]);
-  const v_uint8x16 word0 = v_load(kColor3Shuffle.pixel_word[0]);
-  const v_uint8x16 word1 = v_load(kColor3Shuffle.pixel_word[1]);
-  const v_uint8x16 word2 = v_load(kColor3Shuffle.pixel_word[2]);
-  const v_uint8x16 out0 = v_load(kColor3Shuffle.output_byte[0]);
-  const v_uint8x16 out1 = v_load(kColor3Shuffle.output_byte[1]);
-  const v_uint8x16 out2 = v_load(kColor3Shuffle.output_byte[2]);
+  const Color3Consts k = LoadColor3Consts();
   int64_t shuffled = 0, portable = 0, scalar = 0;
   int32_t X = X0, Y = Y0;
   // The group's 4 coordinates, stepped like X and Y.
@@ -205,45 +269,8 @@ STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
       }
       continue;
     }
-    const uchar* p = base + static_cast<size_t>(iy0) * step + ix0 * 3;
-    const v_uint8x16 top = v_load(p);
-    const v_uint8x16 bottom = v_load(p + step);
-    // Each pixel's byte offset from pixel ix0 (0..9), and its weights, one
-    // 32-bit lane per pixel (adds and 16-bit multiplies rather than shifts:
-    // shifts share the shuffles' ports).
-    const v_int32x4 rel = v_shr<shift>(Xv) - v_setall_s32(ix0);
-    const v_uint8x16 off = v_reinterpret_as_u8(rel + rel + rel);
-    const v_int32x4 fx = v_shr<kScanFrac>(Xv) & m31;
-    // Bytes (32 - fx, fx): 32 + 255 fx (fx < 32: the high 16 bits stay 0).
-    const v_uint8x16 wx = v_reinterpret_as_u8(
-        k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fx), k255)));
-    const v_int32x4 fy64 = v_shr<kScanFrac - 6>(Yv) & m31x64;
-    // 16-bit halves (64 (32 - fy), 64 fy).
-    const v_uint8x16 wy =
-        v_reinterpret_as_u8((k32x64 - fy64) | v_shl<16>(fy64));
-    // Horizontal step, per row and pair.
-    const v_uint8x16 idx_a = ShuffleBytes(off, pix_a) + off_a;
-    const v_uint8x16 idx_b = ShuffleBytes(off, pix_b) + off_b;
-    const v_uint8x16 w_a = ShuffleBytes(wx, wsel_a);
-    const v_uint8x16 w_b = ShuffleBytes(wx, wsel_b);
-    const v_int16x8 top_a = MulAddPairs(ShuffleBytes(top, idx_a), w_a);
-    const v_int16x8 top_b = MulAddPairs(ShuffleBytes(top, idx_b), w_b);
-    const v_int16x8 bot_a = MulAddPairs(ShuffleBytes(bottom, idx_a), w_a);
-    const v_int16x8 bot_b = MulAddPairs(ShuffleBytes(bottom, idx_b), w_b);
-    // Vertical step: (top, bottom) per pair, P = 0-3, 4-7, 8-11; rounded,
-    // and the result byte picked out.
-    v_int16x8 z0, z1, z2, unused;
-    v_zip(top_a, bot_a, z0, z1);
-    v_zip(top_b, bot_b, z2, unused);
-    const v_int32x4 h0 =
-        v_dotprod(z0, v_reinterpret_as_s16(ShuffleBytes(wy, word0))) + half;
-    const v_int32x4 h1 =
-        v_dotprod(z1, v_reinterpret_as_s16(ShuffleBytes(wy, word1))) + half;
-    const v_int32x4 h2 =
-        v_dotprod(z2, v_reinterpret_as_s16(ShuffleBytes(wy, word2))) + half;
-    const v_uint8x16 r = ShuffleBytes(v_reinterpret_as_u8(h0), out0) |
-                         ShuffleBytes(v_reinterpret_as_u8(h1), out1) |
-                         ShuffleBytes(v_reinterpret_as_u8(h2), out2);
+    const v_uint8x16 r =
+        Color3Group(k, base + static_cast<size_t>(iy0) * step + ix0 * 3, step, ix0, Xv, Yv);
     if (u + 6 <= width) {
       v_store(dst, r);  // bytes 12-15 (zero): the next pixels', written later
     } else {
@@ -257,6 +284,81 @@ STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
   counts->portable_simd_px += portable;
   counts->scalar_px += scalar;
 }
+namespace {
+
+// The 1-channel kernel's constants and tables, loaded once per segment.
+struct Mono8Consts {
+  cv::v_int32x4 m31, m31x64, k32, k32x64, half;
+  cv::v_uint16x8 k255;
+  cv::v_uint8x16 pair_low, left_right, out0, out1;
+};
+
+STEADIFACE_SHUFFLE_TARGET inline Mono8Consts LoadMono8Consts() {
+  using namespace cv;
+  // Pixel k's offset (16-bit lane k, < 16) to both bytes of pair k, plus
+  // (0, 1): the left and right columns.
+  alignas(16) static constexpr uint8_t kPairLow[16] = {
+      0, 0, 2, 2, 4, 4, 6, 6, 8, 8, 10, 10, 12, 12, 14, 14};
+  alignas(16) static constexpr uint8_t kLeftRight[16] = {
+      0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1};
+  // Byte 2 of sums 0 and 1's lanes to output bytes 0-3 and 4-7.
+  alignas(16) static constexpr uint8_t kOut0[16] = {
+      2,    6,    10,   14,   0x80, 0x80, 0x80, 0x80,
+      0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
+  alignas(16) static constexpr uint8_t kOut1[16] = {
+      0x80, 0x80, 0x80, 0x80, 2,    6,    10,   14,
+      0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
+  Mono8Consts k;
+  k.m31 = v_setall_s32(kInterTabSize - 1);
+  k.m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
+  k.k32 = v_setall_s32(kInterTabSize);
+  k.k32x64 = v_setall_s32(kInterTabSize << 6);
+  k.k255 = v_setall_u16(255);
+  k.half = v_setall_s32(1 << 15);
+  k.pair_low = v_load(kPairLow);
+  k.left_right = v_load(kLeftRight);
+  k.out0 = v_load(kOut0);
+  k.out1 = v_load(kOut1);
+  return k;
+}
+
+// One group of 8 pixels at (Xa, Ya) and (Xb, Yb) whose sources lie in the
+// row pair at `p` (pixel ix0) within 16 bytes: their 8 output bytes, low half.
+STEADIFACE_SHUFFLE_TARGET inline cv::v_uint8x16 Mono8Group(
+    const Mono8Consts& k, const uchar* p, size_t step, int ix0, const cv::v_int32x4& Xa,
+    const cv::v_int32x4& Xb, const cv::v_int32x4& Ya, const cv::v_int32x4& Yb) {
+  using namespace cv;
+  constexpr int shift = kScanFrac + kInterBits;
+  const v_uint8x16 top = v_load(p);
+  const v_uint8x16 bottom = v_load(p + step);
+  // Offsets from ix0 (0..14) and horizontal weight bytes (32 - fx, fx)
+  // = 32 + 255 fx, one 16-bit lane per pixel.
+  const v_int32x4 col0 = v_setall_s32(ix0);
+  const v_uint8x16 rel =
+      v_reinterpret_as_u8(v_pack(v_shr<shift>(Xa) - col0, v_shr<shift>(Xb) - col0));
+  const v_int32x4 fxa = v_shr<kScanFrac>(Xa) & k.m31;
+  const v_int32x4 fxb = v_shr<kScanFrac>(Xb) & k.m31;
+  const v_uint8x16 wx = v_reinterpret_as_u8(
+      v_pack(k.k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fxa), k.k255)),
+             k.k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fxb), k.k255))));
+  const v_uint8x16 idx = ShuffleBytes(rel, k.pair_low) + k.left_right;
+  const v_int16x8 t = MulAddPairs(ShuffleBytes(top, idx), wx);
+  const v_int16x8 b = MulAddPairs(ShuffleBytes(bottom, idx), wx);
+  // Vertical step with 64 ((32 - fy), fy) per 32-bit lane (pixel).
+  const v_int32x4 fya = v_shr<kScanFrac - 6>(Ya) & k.m31x64;
+  const v_int32x4 fyb = v_shr<kScanFrac - 6>(Yb) & k.m31x64;
+  const v_int16x8 wya = v_reinterpret_as_s16((k.k32x64 - fya) | v_shl<16>(fya));
+  const v_int16x8 wyb = v_reinterpret_as_s16((k.k32x64 - fyb) | v_shl<16>(fyb));
+  v_int16x8 z0, z1;
+  v_zip(t, b, z0, z1);
+  const v_int32x4 h0 = v_dotprod(z0, wya) + k.half;
+  const v_int32x4 h1 = v_dotprod(z1, wyb) + k.half;
+  return ShuffleBytes(v_reinterpret_as_u8(h0), k.out0) |
+         ShuffleBytes(v_reinterpret_as_u8(h1), k.out1);
+}
+
+}  // namespace
+
 // The shuffle kernel, 1 channel, 8 output pixels per step: when the 8 read
 // one source row pair and at most 15 adjacent columns (ix0..ix0+14 and
 // their right neighbours), one 16-byte load per row holds them all. One
@@ -293,28 +395,7 @@ STEADIFACE_SHUFFLE_TARGET void Mono8SegmentShuffle(const ScanSegment& seg,
   const v_int32x4 rampy(0, DY, 2 * DY, 3 * DY);
   const v_int32x4 dx4 = v_setall_s32(4 * DX), dy4 = v_setall_s32(4 * DY);
   const v_int32x4 dx8 = v_setall_s32(8 * DX), dy8 = v_setall_s32(8 * DY);
-  const v_int32x4 m31 = v_setall_s32(kInterTabSize - 1);
-  const v_int32x4 m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
-  const v_int32x4 k32 = v_setall_s32(kInterTabSize);
-  const v_int32x4 k32x64 = v_setall_s32(kInterTabSize << 6);
-  const v_uint16x8 k255 = v_setall_u16(255);
-  const v_int32x4 half = v_setall_s32(1 << 15);
-  // Pixel k's offset (16-bit lane k, < 16) to both bytes of pair k, plus
-  // (0, 1): the left and right columns.
-  alignas(16) static constexpr uint8_t kPairLow[16] = {
-      0, 0, 2, 2, 4, 4, 6, 6, 8, 8, 10, 10, 12, 12, 14, 14};
-  alignas(16) static constexpr uint8_t kLeftRight[16] = {
-      0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1};
-  // Byte 2 of sums 0 and 1's lanes to output bytes 0-3 and 4-7.
-  alignas(16) static constexpr uint8_t kOut0[16] = {
-      2,    6,    10,   14,   0x80, 0x80, 0x80, 0x80,
-      0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
-  alignas(16) static constexpr uint8_t kOut1[16] = {
-      0x80, 0x80, 0x80, 0x80, 2,    6,    10,   14,
-      0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
-  const v_uint8x16 pair_low = v_load(kPairLow);
-  const v_uint8x16 left_right = v_load(kLeftRight);
-  const v_uint8x16 out0 = v_load(kOut0), out1 = v_load(kOut1);
+  const Mono8Consts k = LoadMono8Consts();
   int64_t shuffled = 0, portable = 0, scalar = 0;
   int32_t X = X0, Y = Y0;
   v_int32x4 Xa = v_setall_s32(X0) + ramp, Ya = v_setall_s32(Y0) + rampy;
@@ -345,33 +426,7 @@ STEADIFACE_SHUFFLE_TARGET void Mono8SegmentShuffle(const ScanSegment& seg,
       continue;
     }
     const uchar* p = base + static_cast<size_t>(iy0) * step + ix0;
-    const v_uint8x16 top = v_load(p);
-    const v_uint8x16 bottom = v_load(p + step);
-    // Offsets from ix0 (0..14) and horizontal weight bytes (32 - fx, fx)
-    // = 32 + 255 fx, one 16-bit lane per pixel.
-    const v_int32x4 col0 = v_setall_s32(ix0);
-    const v_uint8x16 rel = v_reinterpret_as_u8(
-        v_pack(v_shr<shift>(Xa) - col0, v_shr<shift>(Xb) - col0));
-    const v_int32x4 fxa = v_shr<kScanFrac>(Xa) & m31;
-    const v_int32x4 fxb = v_shr<kScanFrac>(Xb) & m31;
-    const v_uint8x16 wx = v_reinterpret_as_u8(v_pack(
-        k32 + v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fxa), k255)),
-        k32 +
-            v_reinterpret_as_s32(v_mul_wrap(v_reinterpret_as_u16(fxb), k255))));
-    const v_uint8x16 idx = ShuffleBytes(rel, pair_low) + left_right;
-    const v_int16x8 t = MulAddPairs(ShuffleBytes(top, idx), wx);
-    const v_int16x8 b = MulAddPairs(ShuffleBytes(bottom, idx), wx);
-    // Vertical step with 64 ((32 - fy), fy) per 32-bit lane (pixel).
-    const v_int32x4 fya = v_shr<kScanFrac - 6>(Ya) & m31x64;
-    const v_int32x4 fyb = v_shr<kScanFrac - 6>(Yb) & m31x64;
-    const v_int16x8 wya = v_reinterpret_as_s16((k32x64 - fya) | v_shl<16>(fya));
-    const v_int16x8 wyb = v_reinterpret_as_s16((k32x64 - fyb) | v_shl<16>(fyb));
-    v_int16x8 z0, z1;
-    v_zip(t, b, z0, z1);
-    const v_int32x4 h0 = v_dotprod(z0, wya) + half;
-    const v_int32x4 h1 = v_dotprod(z1, wyb) + half;
-    v_store_low(out + u, ShuffleBytes(v_reinterpret_as_u8(h0), out0) |
-                             ShuffleBytes(v_reinterpret_as_u8(h1), out1));
+    v_store_low(out + u, Mono8Group(k, p, step, ix0, Xa, Xb, Ya, Yb));
     shuffled += 8;
   }
   counts->shuffle_px += shuffled;

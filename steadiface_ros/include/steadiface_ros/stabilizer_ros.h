@@ -62,6 +62,13 @@ class StabilizerRos : public OutputSink {
   ros::Time Now() const override { return ros::Time::now(); }
 
  private:
+  // The constructor's steps, in order: parameters (false: invalid, the node
+  // stays idle), reconfigure, publishers, diagnostics, subscribers.
+  bool LoadParameters();
+  void StartReconfigure();
+  void Advertise();
+  void StartDiagnostics();
+  std::string Subscribe(bool* builtin_compressed);
   void OnImage(const sensor_msgs::ImageConstPtr& image,
                const sensor_msgs::CameraInfoConstPtr& info);
   // With camera_info_url, or compressed images without the

@@ -66,6 +66,7 @@ std::string TruthJson(const ReportInputs& r, const BagSink& sink) {
   tj << ",\n  \"ground_truth\": {\"truth\": \"" << r.truth << "\""
      << ", \"scorer\": \"eval::Scorecard\", \"frames\": " << r.scorer->frames()
      << ", \"frames_not_in_truth\": " << r.scorer->unmatched()
+     << ", \"scoring_time_s\": " << Num(r.scoring_s)
      << ", \"head_jitter_in_px\": " << Num(in.head_jitter_px)
      << ", \"head_jitter_out_px\": " << Num(out.head_jitter_px)
      << ", \"head_jitter_out_frac\": " << Num(out.head_jitter_frac)

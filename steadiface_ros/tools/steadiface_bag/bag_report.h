@@ -19,7 +19,8 @@ struct ReportInputs {
       plot_dir;  ///< trajectories for scripts/plot_report.py ("" = none)
   std::string plot_name = "bag";
   bool gyro_only = false;
-  double elapsed_s = 0.0;  ///< wall time of the run
+  double elapsed_s = 0.0;  ///< wall time of the run, scoring left out [s]
+  double scoring_s = 0.0;  ///< wall time of the ground-truth scoring [s]
   double crop_ratio = 0.0;
 };
 

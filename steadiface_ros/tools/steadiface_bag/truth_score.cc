@@ -1,5 +1,6 @@
 #include "steadiface_bag/truth_score.h"
 
+#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -59,6 +60,13 @@ steadiface::Status TruthScorer::Create(const std::string& truth_path,
 
 void TruthScorer::Add(steadiface::Time stamp, const steadiface::PipelineFrame& frame,
                       const steadiface::Pipeline& pipeline) {
+  const auto start = std::chrono::steady_clock::now();
+  AddTimed(stamp, frame, pipeline);
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void TruthScorer::AddTimed(steadiface::Time stamp, const steadiface::PipelineFrame& frame,
+                           const steadiface::Pipeline& pipeline) {
   const auto it = frame_by_ms_.find(std::llround(steadiface::ToSeconds(stamp) * 1000.0));
   if (it == frame_by_ms_.end()) {
     ++unmatched_;

@@ -38,14 +38,20 @@ class TruthScorer {
   const steadiface::eval::Scorecard& input_card() const { return *input_; }
   int frames() const { return frames_; }
   int unmatched() const { return unmatched_; }
+  /// Wall time spent scoring (in Add) [s]: not the stabilizer's, so the
+  /// report's throughput leaves it out.
+  double seconds() const { return seconds_; }
 
  private:
   TruthScorer() = default;
+  void AddTimed(steadiface::Time stamp, const steadiface::PipelineFrame& frame,
+                const steadiface::Pipeline& pipeline);
 
   std::unique_ptr<steadiface::sim::Simulator> sim_;
   std::unique_ptr<steadiface::eval::Scorecard> output_, input_;
   std::map<int64_t, int> frame_by_ms_;
   int frames_ = 0, unmatched_ = 0;
+  double seconds_ = 0.0;
 };
 
 }  // namespace steadiface_bag
