@@ -288,6 +288,60 @@ TEST(ParamsTest, AChoiceOutsideTheTablesNamesTheChoices) {
   std::remove(path.c_str());
 }
 
+// The core's validation accepts every value the table's ranges allow: each
+// number at its min and at its max (a pair's partner set to the same end,
+// so low < high still holds).
+TEST(ParamsTest, TheCoreAcceptsEveryValueInTheTablesRanges) {
+  const std::map<std::string, std::string> low_to_high = {
+      {"face/min_spread_ratio", "face/max_spread_ratio"},
+      {"dynamic/gyro_still", "dynamic/gyro_active"},
+      {"dynamic/pose_low", "dynamic/pose_high"},
+      {"dynamic/centre_variation_low", "dynamic/centre_variation_high"},
+      {"dynamic/scale_variation_low", "dynamic/scale_variation_high"}};
+  std::map<std::string, const ParameterSpec*> spec;
+  for (const ParameterSpec& p : ParameterTable()) spec[p.key] = &p;
+  // A source holding only the values the test sets.
+  class Values : public ParamSource {
+   public:
+    std::map<std::string, double> v;
+    bool Get(const std::string& k, double* x) const override {
+      const auto it = v.find(k);
+      if (it == v.end()) return false;
+      *x = it->second;
+      return true;
+    }
+    bool Get(const std::string& k, int* x) const override {
+      const auto it = v.find(k);
+      if (it == v.end()) return false;
+      *x = static_cast<int>(it->second);
+      return true;
+    }
+    bool Get(const std::string&, bool*) const override { return false; }
+    bool Get(const std::string&, std::string*) const override { return false; }
+    bool Get(const std::string&, std::vector<double>*) const override { return false; }
+  };
+  int checked = 0;
+  for (const ParameterSpec& p : ParameterTable()) {
+    if (!p.read_by_node || (p.type != ParameterType::kDouble && p.type != ParameterType::kInt)) {
+      continue;
+    }
+    for (const bool at_max : {false, true}) {
+      Values values;
+      values.v[p.key] = at_max ? p.max : p.min;
+      for (const auto& pair : low_to_high) {
+        if (at_max && pair.first == p.key) values.v[pair.second] = spec[pair.second]->max;
+        if (!at_max && pair.second == p.key) values.v[pair.first] = spec[pair.first]->min;
+      }
+      steadiface::PipelineOptions po;
+      WrapperOptions wo;
+      const steadiface::Status s = LoadOptions(values, &po, &wo);
+      EXPECT_TRUE(s.ok()) << p.key << " = " << values.v[p.key] << ": " << s.message();
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 180);
+}
+
 TEST(ParamsTest, AnOutOfRangeValueNamesItsKey) {
   const std::string path = ::testing::TempDir() + "steadiface_params_test.yaml";
   {
