@@ -97,21 +97,26 @@ TEST_P(LayeredScorecardTest, NeverMovesTheBackgroundAndHoldsTheHead) {
   }
 }
 
-// Head bars met (<= 0.5x gyro-only): walk, vlog, pan, run, two_faces.
-// Still camera: the head is not chased (layered = gyro-only's 1.0x).
-// Not met, guarded at the measured ratio + ~0.1: occlusion (0.49-0.62x over
-// seeds 1-3; global 0.48-0.66x), turn_away (the face turns away: no
-// landmarks; global 0.62x), drift (the head follows its own slow drift in
-// the steady scene by design), walk_across (the subject's motion against
-// the scene exceeds what the band absorbs), shake (the same, at 3x the
-// running trace; global's 0.53x moves the background with the face).
+// Head bars met (<= 0.5x gyro-only): walk, vlog, pan, run, two_faces
+// (0.14-0.36x over seeds 1-3). Still camera: the head is not chased
+// (layered = gyro-only's 1.0x). Not met, guarded at the measured ratio +
+// ~0.1: occlusion (0.47-0.65x; global 0.51-0.66x: the tracker accepts
+// landmarks dragged by the hand as it enters), turn_away (0.58-0.83x: no
+// landmarks while the face is turned away), drift (0.76-0.84x: the head
+// follows its own slow drift in the steady scene by design; no causal
+// policy tried within the reach gets below 0.66x), walk_across
+// (0.65-0.68x: the subject's gait against the scene exceeds what the band
+// absorbs around a face this small for the mesh), shake (0.80-0.82x: even
+// the non-causal optimum within the reach is 0.72-0.74x; global's 0.53x
+// moves the background with the face). docs/evaluation.md, "The face's own
+// cell".
 INSTANTIATE_TEST_SUITE_P(
     Presets, LayeredScorecardTest,
     ::testing::Values(LayeredCase{"walk", 0.5, 3.0}, LayeredCase{"vlog", 0.5, 3.0},
                       LayeredCase{"pan", 0.5, 3.0}, LayeredCase{"run", 0.5, 5.0},
                       LayeredCase{"two_faces", 0.5, 3.0}, LayeredCase{"still", 1.01, 0.3},
                       LayeredCase{"occlusion", 0.6, 3.0, 0.0}, LayeredCase{"turn_away", 0.7, 3.0},
-                      LayeredCase{"drift", 0.95, 3.0}, LayeredCase{"walk_across", 0.8, 3.0},
+                      LayeredCase{"drift", 0.95, 3.0}, LayeredCase{"walk_across", 0.75, 3.0},
                       LayeredCase{"shake", 0.9, 25.0}),
     [](const ::testing::TestParamInfo<LayeredCase>& info) { return info.param.preset; });
 

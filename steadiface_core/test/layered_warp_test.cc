@@ -4,6 +4,7 @@
 // translation.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -49,6 +50,25 @@ SubjectRegion Region(double blend = 1.0) {
   r.shoulder_axes = Eigen::Vector2d(150, 180);
   r.shoulder_centre = r.chin + Eigen::Vector2d(0, 0.6 * 90 + 180);
   r.blend = blend;
+  return r;
+}
+
+// Region() scaled to a jaw of `jaw` px about its head centre, with the
+// landmark centre 0.3 jaw widths below the head ellipse's centre.
+SubjectRegion Head(double jaw) {
+  SubjectRegion r = Region();
+  const double k = jaw / r.jaw_width;
+  auto scale = [&](const Eigen::Vector2d& p) {
+    return Eigen::Vector2d(r.head_centre + k * (p - r.head_centre));
+  };
+  r.chin = scale(r.chin);
+  r.shoulder_centre = scale(r.shoulder_centre);
+  r.jaw_width *= k;
+  r.face_height *= k;
+  r.head_axes *= k;
+  r.neck_half_width *= k;
+  r.shoulder_axes *= k;
+  r.face_centre = r.head_centre + Eigen::Vector2d(0.0, 0.3 * jaw);
   return r;
 }
 
@@ -234,6 +254,154 @@ TEST(LayerBlendTest, TheDefaultBandNeverBendsTheBackground) {
     EXPECT_DOUBLE_EQ(rep.distortion_keep, 1.0);
     EXPECT_DOUBLE_EQ(rep.shift_px, 0.0);  // nothing moves the whole frame
   }
+}
+
+// The joined mesh's offset from the background layer at output point p
+// (bilinear in its cell, as the sampler interpolates).
+Eigen::Vector2d OffsetAt(const Grid& g, const std::vector<Eigen::Vector2f>& out,
+                         const std::vector<Eigen::Vector2f>& background, const Eigen::Vector2d& p) {
+  const int cols = static_cast<int>(g.u.size());
+  int i = 0, j = 0;
+  while (i + 2 < cols && g.u[i + 1] <= p.x()) ++i;
+  while (j + 2 < static_cast<int>(g.v.size()) && g.v[j + 1] <= p.y()) ++j;
+  const double a = (p.x() - g.u[i]) / (g.u[i + 1] - g.u[i]);
+  const double b = (p.y() - g.v[j]) / (g.v[j + 1] - g.v[j]);
+  auto d = [&](int ii, int jj) {
+    const int k = jj * cols + ii;
+    return (out[k] - background[k]).cast<double>().eval();
+  };
+  return (1 - a) * (1 - b) * d(i, j) + a * (1 - b) * d(i + 1, j) + (1 - a) * b * d(i, j + 1) +
+         a * b * d(i + 1, j + 1);
+}
+
+// True when every cell that reaches outside the region's outline keeps all
+// four vertices exactly on the background layer.
+bool BackgroundUnbent(const Grid& g, const SubjectRegion& region,
+                      const std::vector<Eigen::Vector2f>& out,
+                      const std::vector<Eigen::Vector2f>& background) {
+  const int cols = static_cast<int>(g.u.size());
+  for (int j = 0; j + 1 < static_cast<int>(g.v.size()); ++j) {
+    for (int i = 0; i + 1 < cols; ++i) {
+      const int c[4] = {j * cols + i, j * cols + i + 1, (j + 1) * cols + i,
+                        (j + 1) * cols + i + 1};
+      bool reaches_out = false;
+      for (int k : c) reaches_out = reaches_out || region.SignedDistance(g.At(k)) > 0.0;
+      for (int k : c) {
+        if (reaches_out && out[k] != background[k]) return false;
+      }
+    }
+  }
+  return true;
+}
+
+// The face's own cell follows the subject layer (face_core_cells). The
+// band alone leaves a head that is small for the mesh no core at its
+// landmark centre, 0.3 jaw widths below the head ellipse's centre: the centre
+// keeps 6-72 % of the layers' offset (jaw 100-200 px on 20 px cells). With
+// the face core, from a jaw of 7.5 cells (150 px here) up, the centre moves
+// with the subject layer by the whole offset wherever it lies in its cell,
+// up to the reach the report states; the background is never bent, and the
+// cap keeps every cell at 0.5 or more without a pull. The reach is what the
+// room between the core and the band's outer edge allows: a few px where
+// the core nears the neck (jaw 150, low in its cell), the full band width x
+// cap on a large face. A smaller face keeps more of the offset than without
+// the core, but not all of it: its core runs into the band's outer edge.
+TEST(LayerBlendTest, TheFaceCentreFollowsTheSubjectLayerWhereverItLiesInItsCell) {
+  const Grid g;
+  const auto background = g.Background();
+  const LayerBlendOptions o;
+  LayerBlendOptions off;
+  off.face_core_cells = 0.0;
+  for (double jaw : {100.0, 130.0, 150.0, 200.0, 260.0}) {
+    const bool exact = jaw >= 150.0;
+    double least_with = 1.0, least_without = 1.0, least_reach = 1e9;
+    for (double a : {0.0, 0.3, 0.5, 0.8}) {
+      for (double b : {0.0, 0.4, 0.7}) {
+        SubjectRegion region = Head(jaw);
+        region.face_centre += Eigen::Vector2d(a * 20.0, b * 20.0);
+        for (const Eigen::Vector2d& dir : {Eigen::Vector2d(1, 0), Eigen::Vector2d(0, -1),
+                                           Eigen::Vector2d(-0.6, 0.8)}) {
+          LayerBlend probe(g.u, g.v, o);
+          std::vector<Eigen::Vector2f> out;
+          LayerBlendReport rep;
+          probe.Blend(Shifted(background, dir), background, region, 0.0, 840, 460, &out, &rep);
+          least_reach = std::min(least_reach, rep.reach_px);
+          const Eigen::Vector2d T = 0.95 * rep.reach_px * dir;
+          LayerBlend with(g.u, g.v, o), without(g.u, g.v, off);
+          with.Blend(Shifted(background, T), background, region, 0.0, 840, 460, &out, &rep);
+          const Eigen::Vector2d kept = OffsetAt(g, out, background, region.face_centre);
+          least_with = std::min(least_with, kept.dot(T) / T.squaredNorm());
+          if (exact) {
+            EXPECT_LT((kept - T).norm(), 0.02 * T.norm())
+                << "jaw " << jaw << ", face centre " << region.face_centre.transpose()
+                << ", offset " << T.transpose();
+          }
+          EXPECT_TRUE(BackgroundUnbent(g, region, out, background));
+          EXPECT_EQ(rep.folded_cells, 0);
+          EXPECT_GE(rep.min_cell_ratio, 0.5);
+          EXPECT_DOUBLE_EQ(rep.distortion_keep, 1.0);
+          EXPECT_NEAR(rep.capped_offset_px, T.norm(), 1e-3);  // below the cap (float mesh)
+          without.Blend(Shifted(background, T), background, region, 0.0, 840, 460, &out, &rep);
+          const Eigen::Vector2d kept_without = OffsetAt(g, out, background, region.face_centre);
+          least_without = std::min(least_without, kept_without.dot(T) / T.squaredNorm());
+        }
+      }
+    }
+    std::printf("  jaw %.0f px: reach >= %.1f px; the face centre keeps >= %.2f of the offset with "
+                "the face core, %.2f without\n",
+                jaw, least_reach, least_with, least_without);
+    EXPECT_GE(least_with, least_without - 0.01) << "jaw " << jaw;  // never worse
+    if (jaw <= 200.0) EXPECT_GT(least_with, least_without + 0.2) << "jaw " << jaw;
+    if (exact) EXPECT_GT(least_reach, jaw >= 200.0 ? 5.0 : 1.0) << "jaw " << jaw;
+  }
+}
+
+// The largest per-step change of any vertex of the joined mesh while the
+// region (landmark centre at (320, 180) + step (1, 0.5) px) crosses two
+// cells, the layers' offset T fixed [px].
+double WorstVertexStep(const LayerBlendOptions& o, const Eigen::Vector2d& T) {
+  const Grid g;
+  const auto background = g.Background();
+  LayerBlend blend(g.u, g.v, o);
+  std::vector<Eigen::Vector2f> out, previous;
+  LayerBlendReport rep;
+  double worst = 0.0;
+  for (int step = 0; step <= 40; ++step) {
+    SubjectRegion region = Region();
+    const Eigen::Vector2d move(step * 1.0, step * 0.5);
+    region.head_centre += move;
+    region.chin += move;
+    region.shoulder_centre += move;
+    region.face_centre = Eigen::Vector2d(320.0, 180.0) + move;
+    blend.Blend(Shifted(background, T), background, region, 1.0 / 30.0, 840, 460, &out, &rep);
+    for (size_t k = 0; k < previous.size(); ++k) {
+      worst = std::max(worst, static_cast<double>((out[k] - previous[k]).norm()));
+    }
+    previous = out;
+  }
+  return worst;
+}
+
+// The band and the face core move with the face without jumps: as the
+// region crosses two cells in 1 px steps, the layers' offset fixed, every
+// vertex's offset changes by a small fraction of the offset per step. (Before
+// the band's edges were firm, a vertex crossing one stepped by the whole
+// offset, 9.8 px, here.)
+TEST(LayerBlendTest, TheFaceCoreMovesWithTheFaceWithoutJumps) {
+  const Eigen::Vector2d T(9.0, -4.0);
+  LayerBlendOptions without_core;
+  without_core.face_core_cells = 0.0;
+  const double with = WorstVertexStep(LayerBlendOptions(), T);
+  const double without = WorstVertexStep(without_core, T);
+  std::printf("  largest vertex step per 1 px of face motion: %.3f px with the face core, %.3f px "
+              "without (offset %.1f px)\n",
+              with, without, T.norm());
+  // The profile slides with the face by ~|T| / band width per px; a vertex
+  // that switched between held and free would step by much of |T|. (Without
+  // the face core the cap does not engage here and the band's inner edge,
+  // under the chin, steps by up to a quarter of |T|.)
+  EXPECT_LT(with, 0.06 * T.norm());
+  EXPECT_LT(without, 0.25 * T.norm());
 }
 
 // The similarity term is what tames the bending: the optimized band is less

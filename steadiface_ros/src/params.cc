@@ -391,6 +391,7 @@ void ReadLayered(Reader& r, steadiface::LayeredWarpOptions* lw) {
   r.Num("warp/layered/band_width", &lw->blend.band_width);
   r.Num("warp/layered/band_inside", &lw->blend.band_inside);
   r.Num("warp/layered/outline_margin", &lw->blend.outline_margin_cells);
+  r.Num("warp/layered/face_core", &lw->blend.face_core_cells);
   r.Num("warp/layered/max_offset", &lw->blend.max_offset);
   r.Num("warp/layered/offset_lowpass", &lw->blend.offset_lowpass_hz);
   r.Num("warp/layered/band_data_weight", &lw->blend.band_data_weight);
@@ -492,6 +493,7 @@ void ApplyConfig(const steadiface::SteadifaceConfig& c, steadiface::WarpMode* mo
   layered->blend.band_width = c.band_width;
   layered->blend.band_inside = c.band_inside;
   layered->blend.outline_margin_cells = c.outline_margin;
+  layered->blend.face_core_cells = c.face_core;
   layered->blend.max_offset = c.max_offset;
   layered->blend.offset_lowpass_hz = c.offset_lowpass;
   layered->blend.yield_to_subject = c.yield_to_subject;
@@ -543,6 +545,7 @@ steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::StabilizerOptio
   c.band_width = w.layered.blend.band_width;
   c.band_inside = w.layered.blend.band_inside;
   c.outline_margin = w.layered.blend.outline_margin_cells;
+  c.face_core = w.layered.blend.face_core_cells;
   c.max_offset = w.layered.blend.max_offset;
   c.offset_lowpass = w.layered.blend.offset_lowpass_hz;
   c.yield_to_subject = w.layered.blend.yield_to_subject;

@@ -31,6 +31,16 @@ struct Triangle {
   int v1, v2, v3;
 };
 
+// The data weight of a firm vertex (the face's core, the band's edges) over
+// the shape weight: a firm vertex lands within ~1 % of its target.
+constexpr double kFirmWeight = 100.0;
+// The band's firm edges: the fraction of the band, from each edge, over
+// which the firmness fades out.
+constexpr double kFirmEdge = 0.5;
+// The face's core fades in over this many cell diagonals inside the band's
+// outer edge.
+constexpr double kCoreFade = 0.25;
+
 double Excess(const Eigen::Vector2d& p, double w1, double h1) {
   return std::max({0.0, -p.x(), p.x() - w1, -p.y(), p.y() - h1});
 }
@@ -54,6 +64,9 @@ Status ValidateLayerBlendOptions(const LayerBlendOptions& o) {
   } else if (!in(o.outline_margin_cells, 0.0, 4.0)) {
     err << "warp.layered.outline_margin must be in [0, 4] cells, got "
         << o.outline_margin_cells;
+  } else if (!in(o.face_core_cells, 0.0, 4.0)) {
+    err << "warp.layered.face_core must be in [0, 4] cells (0 = off), got "
+        << o.face_core_cells;
   } else if (!in(o.offset_lowpass_hz, 0.0, 10.0)) {
     err << "warp.layered.offset_lowpass_hz must be in [0, 10] Hz (0 = off), "
            "got "
@@ -232,12 +245,53 @@ void LayerBlend::BandWeights(const SubjectRegion& region, std::vector<bool>* fre
       (1.0 - options_.band_inside) * B - options_.outline_margin_cells * cell_diagonal_;
   r->band_px = B;
   r->band_outer_px = outer;
+  region.GridDistances(u_, v_, &distance_);
+  FaceCoreWeights(region);
+  firm_.assign(n, 0.0);
   free_vertex->assign(n, false);
+  double room = B;  // from the face's core to the band's outer edge
   for (int k = 0; k < n; ++k) {
-    const double dist = region.SignedDistance(Eigen::Vector2d(u_[k % cols_], v_[k / cols_]));
-    const double s = std::min(1.0, std::max(0.0, (outer - dist) / B));
+    const double inside = outer - distance_[k];
+    const double s = std::min(1.0, std::max(0.0, inside / B));
     alpha_[k] = region.blend * s * s * (3.0 - 2.0 * s);
+    // The face's core bounds the room the band has (a vertex's bound
+    // loosens by a cell diagonal as its core weight falls to 0, so the room
+    // moves continuously with the face), and pulls only inside the band's
+    // outer edge, fading in over a quarter cell diagonal from it (beyond it
+    // every vertex stays on the background layer).
+    if (core_[k] > 0.0) room = std::min(room, inside + (1.0 - core_[k]) * cell_diagonal_);
+    core_[k] *= std::min(1.0, std::max(0.0, inside / (kCoreFade * cell_diagonal_)));
+    alpha_[k] = std::max(alpha_[k], region.blend * core_[k]);
     (*free_vertex)[k] = s > 0.0 && s < 1.0;
+    // Firm near the band's edges: a vertex that crosses an edge (held on
+    // one side, free on the other) keeps its place, instead of jumping by
+    // whatever the shape term gives a barely held vertex.
+    const double edge = std::max(0.0, 1.0 - std::min(s, 1.0 - s) / kFirmEdge);
+    firm_[k] = std::max(core_[k], edge);
+  }
+  r->room_px = std::max(1.0, std::min(B, room));
+  r->reach_px = options_.max_offset * r->room_px;
+}
+
+void LayerBlend::FaceCoreWeights(const SubjectRegion& region) {
+  // 1 within face_core_cells cells (per axis) of the landmark centre, fading
+  // linearly to 0 one cell further out: every vertex of the cell under the
+  // centre gets 1, and the weights move continuously with the face.
+  const int n = cols_ * rows_;
+  core_.assign(n, 0.0);
+  const double c = options_.face_core_cells;
+  if (c <= 0.0 || !region.face_centre.allFinite()) return;
+  const Eigen::Vector2d& f = region.face_centre;
+  for (int k = 0; k < n; ++k) {
+    const int i = k % cols_, j = k / cols_;
+    // The cell size around vertex k (the mean of its two neighbouring cells).
+    const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, cols_ - 1);
+    const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, rows_ - 1);
+    const double cu = (u_[i1] - u_[i0]) / std::max(1, i1 - i0);
+    const double cv = (v_[j1] - v_[j0]) / std::max(1, j1 - j0);
+    const double wx = std::min(1.0, std::max(0.0, 1.0 + c - std::abs(u_[i] - f.x()) / cu));
+    const double wy = std::min(1.0, std::max(0.0, 1.0 + c - std::abs(v_[j] - f.y()) / cv));
+    core_[k] = wx * wy;
   }
 }
 
@@ -275,7 +329,7 @@ double LayerBlend::SplitHeadOffset(const std::vector<Eigen::Vector2f>& subject,
   *fast = Dc - smooth_;
   r->offset_px = region.blend * fast->norm() / in_per_out;
   double cap = 1.0;
-  const double max_offset_px = options_.max_offset * r->band_px;
+  const double max_offset_px = r->reach_px;
   if (max_offset_px > 0 && r->offset_px > max_offset_px) cap = max_offset_px / r->offset_px;
   r->capped_offset_px = r->offset_px * cap;
   // Yielding to the subject, what the cap takes from the band moves the
@@ -319,7 +373,11 @@ Eigen::VectorXd LayerBlend::SolveBand(const Eigen::VectorXd& target,
     if (f < 0) continue;
     // Temporal: the correction d - T changes slowly (not d itself, which
     // must follow the subject without lag).
-    const double wd = options_.band_data_weight;
+    // The face's core (FaceCoreWeights) and the band's edges are pulled to
+    // their targets as firmly as held vertices; the band's middle only
+    // weakly (there the shape term decides).
+    const double firm = kFirmWeight * std::max(1.0, options_.shape_weight) * firm_[q / 2];
+    const double wd = options_.band_data_weight + firm;
     triplets_.emplace_back(f, f, wd + wt);
     rhs(f) += wd * target(q) + wt * (target(q) + e_previous_(q));
   }

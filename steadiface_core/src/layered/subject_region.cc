@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <opencv2/imgproc.hpp>
+
 namespace steadiface {
 namespace {
 
@@ -64,6 +66,61 @@ double SubjectRegion::SignedDistance(const Eigen::Vector2d& p) const {
   return d;
 }
 
+void SubjectRegion::GridDistances(const std::vector<double>& u, const std::vector<double>& v,
+                                  std::vector<double>* sd) const {
+  sd->assign(u.size() * v.size(), 0.0);
+  if (u.size() < 2 || v.size() < 2) return;
+  const double cell = std::min((u.back() - u.front()) / (u.size() - 1),
+                               (v.back() - v.front()) / (v.size() - 1));
+  const double res = std::max(0.25, 0.25 * cell), pad = cell;
+  const double x0 = u.front() - pad, y0 = v.front() - pad;
+  const int w = static_cast<int>(std::ceil((u.back() - u.front() + 2 * pad) / res)) + 2;
+  const int h = static_cast<int>(std::ceil((v.back() - v.front() + 2 * pad) / res)) + 2;
+  // The region's union on the raster (sub-pixel placement: 4 fractional
+  // bits), raster pixel (i, j) centred at output (x0 + i res, y0 + j res).
+  constexpr int kShift = 4;
+  auto fx = [&](double x) { return static_cast<int>(std::lround((x - x0) / res * (1 << kShift))); };
+  auto fy = [&](double y) { return static_cast<int>(std::lround((y - y0) / res * (1 << kShift))); };
+  auto fl = [&](double l) { return static_cast<int>(std::lround(l / res * (1 << kShift))); };
+  cv::Mat mask(h, w, CV_8U, cv::Scalar(0)), depth;
+  auto ellipse = [&](const Eigen::Vector2d& c, const Eigen::Vector2d& a) {
+    cv::ellipse(mask, cv::Point(fx(c.x()), fy(c.y())), cv::Size(fl(a.x()), fl(a.y())), 0.0, 0.0,
+                360.0, cv::Scalar(255), cv::FILLED, cv::LINE_8, kShift);
+  };
+  ellipse(head_centre, head_axes);
+  if (torso) {
+    cv::rectangle(mask, cv::Point(fx(chin.x() - neck_half_width), fy(chin.y() - 0.3 * face_height)),
+                  cv::Point(fx(chin.x() + neck_half_width), fy(chin.y() + 1.0 * face_height)),
+                  cv::Scalar(255), cv::FILLED, cv::LINE_8, kShift);
+    ellipse(shoulder_centre, shoulder_axes);
+  }
+  // Depth inside (5x5 chamfer: within 2 % of the Euclidean distance); a
+  // pixel next to the outline is half a pixel from it.
+  cv::distanceTransform(mask, depth, cv::DIST_L2, cv::DIST_MASK_5);
+  auto at = [&](int i, int j) {
+    const float d = depth.at<float>(std::min(std::max(j, 0), h - 1), std::min(std::max(i, 0), w - 1));
+    return d > 0.0f ? d - 0.5 : 0.0;
+  };
+  for (size_t j = 0; j < v.size(); ++j) {
+    for (size_t i = 0; i < u.size(); ++i) {
+      const Eigen::Vector2d p(u[i], v[j]);
+      // Outside, SignedDistance is right (the nearest shape's distance);
+      // inside it is a lower bound on the depth.
+      const double analytic = SignedDistance(p);
+      double& out = (*sd)[j * u.size() + i];
+      out = analytic;
+      if (analytic > 0.0) continue;
+      const double px = (u[i] - x0) / res, py = (v[j] - y0) / res;
+      const int ix = static_cast<int>(std::floor(px)), iy = static_cast<int>(std::floor(py));
+      const double a = px - ix, b = py - iy;
+      const double d = ((1 - a) * (1 - b) * at(ix, iy) + a * (1 - b) * at(ix + 1, iy) +
+                        (1 - a) * b * at(ix, iy + 1) + a * b * at(ix + 1, iy + 1)) * res;
+      // Conservative: less the raster's half diagonal and the chamfer's 2 %.
+      out = -std::max(-analytic, 0.98 * d - 0.5 * std::sqrt(2.0) * res);
+    }
+  }
+}
+
 SubjectRegion SubjectRegionTracker::Measure(const CameraModel& model,
                                             const OutputGeometry& output,
                                             const Eigen::Quaterniond& R_v,
@@ -108,6 +165,9 @@ SubjectRegion SubjectRegionTracker::Measure(const CameraModel& model,
             Eigen::Vector2d(0.5 * (x0 + x1), 0.5 * (top + bottom));
         measured.head_axes =
             Eigen::Vector2d(o.head_width_scale * w, 0.5 * (bottom - top));
+        Eigen::Vector2d c = Eigen::Vector2d::Zero();
+        for (const auto& q : out) c += q;
+        measured.face_centre = c / 68.0;
       }
     }
   }
@@ -137,6 +197,7 @@ const SubjectRegion& SubjectRegionTracker::Update(
                            : 1.0;
       const Eigen::Vector2d chin_offset = r.chin - r.head_centre;
       r.head_centre = measured.head_centre;
+      r.face_centre = measured.face_centre;
       r.head_axes += a * (measured.head_axes - r.head_axes);
       r.chin = r.head_centre + chin_offset +
                a * ((measured.chin - measured.head_centre) - chin_offset);

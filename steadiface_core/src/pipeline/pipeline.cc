@@ -195,6 +195,13 @@ Status Pipeline::WarpStep(const cv::Mat& image, Time stamp, const FaceObservatio
                                     b.valid ? b.t : f.stabilizer.t, f.stabilizer.rows,
                                     f.layered.region, dt);
     f.layered.blend = warper_->blend_report();
+    // What the band absorbs (the face's size against the mesh) bounds the
+    // next frame's head target.
+    const SubjectRegion& region = f.layered.region;
+    stabilizer_->SetReachLimit(s.ok() && region.valid && f.layered.blend.layered &&
+                                       region.jaw_width > 0.0
+                                   ? f.layered.blend.reach_px / region.jaw_width
+                                   : 0.0);
     f.timings.mesh_ms = warper_->timings().mesh_ms;
     if (s.ok() && render) {
       s = warper_->Render(image, &f.output);

@@ -120,6 +120,7 @@ Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
 
 void Stabilizer::reset() {
   subject_ = LayerState();
+  reach_limit_ = 0.0;
   background_ = LayerState();
   has_held_face_ = false;
   dynamic_.reset();
@@ -372,7 +373,10 @@ void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, double d
   }
   const double jaw = seen.landmarks.size() == 68 ? (seen.landmarks[0] - seen.landmarks[16]).norm()
                                                  : 2.0 * seen.scale;
-  const double reach = options_.subject_reach * jaw;
+  const double fraction = reach_limit_ > 0.0 ? std::min(options_.subject_reach, reach_limit_)
+                                              : options_.subject_reach;
+  const double reach = fraction * jaw;
+  f->subject_reach = reach;
   Eigen::Vector2d H = f->H;
   if (options_.subject_reach_lowpass_hz > 0.0) {
     // Follow the slow part S of where the background layer shows the face

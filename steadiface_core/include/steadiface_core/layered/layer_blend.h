@@ -29,6 +29,16 @@ struct LayerBlendOptions {
   /// layer; 1 (with band_inside 1) keeps every pixel outside the outline on
   /// the background layer [cells].
   double outline_margin_cells = 1.0;
+  /// The face's own cell follows the subject layer: vertices within this
+  /// many cells (per axis) of the face's landmark centre, the point E_f puts
+  /// at H, are pulled to the subject layer as firmly as held vertices, and
+  /// the pull fades out over one more cell (continuous as the face moves
+  /// across cells). Without it a face that is small for the mesh has no
+  /// exact core, and its centre is interpolated partly from band vertices
+  /// (vlog: 60 % of the layer offset reached the face). The cap below is then
+  /// measured against the room left between this core and the band's outer
+  /// edge, when that is less than band_width. 0 = off [cells].
+  double face_core_cells = 1.0;
   /// Cap on the layer offset the band absorbs, measured at the head centre,
   /// as a fraction of the band's width [-]: the band's local stretch stays
   /// below about 1.5x this (the smoothstep's steepest slope). Beyond it one
@@ -80,6 +90,13 @@ struct LayerBlendReport {
   /// Band width this frame, and its outer edge's distance outside the
   /// region's outline (the inner edge is band_px inside that) [output px].
   double band_px = 0.0, band_outer_px = 0.0;
+  /// The band's width as the cap sees it: band_px, or less when the face's
+  /// core (face_core_cells) lies closer than that to the band's outer edge
+  /// [output px].
+  double room_px = 0.0;
+  /// The largest offset at the head centre the band absorbs before the cap
+  /// (max_offset x room_px) [output px]; 0 when not layered.
+  double reach_px = 0.0;
   /// The fast part of the layer offset at the head centre, before / after
   /// the cap [output px], and what shifts the whole frame: the slow part
   /// and, yielding to the subject, what the cap leaves over [output px].
@@ -116,10 +133,19 @@ struct LayerBlendReport {
 /// slow part of the offset at the head centre (offset_lowpass_hz; it shifts
 /// the whole frame), g the region's blend, a_k
 /// the region's blend at vertex k (g in the core, falling to 0 over the band
-/// by a smoothstep; the band straddles the region's outline) and w_b the
-/// band's data weight. The core follows the subject layer and the rest of
-/// the frame the background layer exactly; only the band's vertices are
-/// unknowns. S_tri is the similarity residual of
+/// by a smoothstep of the vertex's distance to the region's outline,
+/// SubjectRegion::GridDistances) and w_b the band's data weight. The core
+/// follows the subject layer and the rest of the frame the background layer
+/// exactly; only the band's vertices are unknowns. Two things make the data
+/// weight firm (as firm as a held vertex) where it must be: the band's edges,
+/// so that a vertex crossing an edge as the face moves (held on one side,
+/// free on the other) does not jump; and the face's core, the vertices
+/// within face_core_cells of the landmark centre (the point E_f puts at H),
+/// whose target is g D_k whatever the band's profile there, so that a face
+/// that is small for the mesh still moves with its layer. Both fade
+/// continuously. The cap below is measured against the room between the
+/// face's core and the band's outer edge when that is narrower than the
+/// band (LayerBlendReport::room_px, reach_px). S_tri is the similarity residual of
 /// Liu et al.: each triangle's third vertex expressed in the frame of the
 /// other two must keep the relative coordinates it has on the output grid,
 /// so d may translate, rotate and scale locally but not shear. Four
@@ -127,9 +153,10 @@ struct LayerBlendReport {
 /// (Eigen SimplicialLDLT per frame; the held vertices enter the right-hand
 /// side).
 ///
-/// The cap: where |g (D_c - S)| at the head centre exceeds max_offset band
-/// widths, the band absorbs only the cap's share of it; yielding to the
-/// subject (the default) the rest, g (1 - cap) (D_c - S), joins the whole
+/// The cap: where |g (D_c - S)| at the head centre exceeds max_offset times
+/// the band's width (or its room beside the face's core, if less), the band
+/// absorbs only the cap's share of it; yielding to the
+/// subject (yield_to_subject) the rest, g (1 - cap) (D_c - S), joins the whole
 /// frame's shift, so the core still follows the subject layer; otherwise
 /// the core follows the background layer in part.
 ///
@@ -170,9 +197,13 @@ class LayerBlend {
   // Output px per input px, from the background mesh's middle row.
   double InputPerOutput(const std::vector<Eigen::Vector2f>& background) const;
   // Each vertex's blend weight a_k into alpha_, whether it is a band vertex
-  // (an unknown), and the band's width and outer edge into *r.
+  // (an unknown), how firmly it keeps its target (firm_), and the band's
+  // width, outer edge, room beside the face's core and reach into *r.
   void BandWeights(const SubjectRegion& region, std::vector<bool>* free_vertex,
                    LayerBlendReport* r);
+  // Each vertex's pull towards the subject layer around the face's
+  // landmark centre (face_core_cells) into core_ [0-1].
+  void FaceCoreWeights(const SubjectRegion& region);
   // The layer offset subject - background at output point h (bilinear).
   Eigen::Vector2d OffsetAt(const std::vector<Eigen::Vector2f>& subject,
                            const std::vector<Eigen::Vector2f>& background,
@@ -222,6 +253,11 @@ class LayerBlend {
   TrackingLowpass offset_lowpass_;
   Eigen::Vector2d smooth_ = Eigen::Vector2d::Zero();
   std::vector<double> alpha_;
+  std::vector<double> distance_;  // SubjectRegion::GridDistances per vertex
+  std::vector<double> core_;      // FaceCoreWeights
+  // How firmly each vertex keeps its target (the face's core, the band's
+  // edges) [0-1].
+  std::vector<double> firm_;
   std::vector<double> ratios_scratch_;
 };
 

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <cmath>
+#include <vector>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -43,6 +46,10 @@ Status ValidateSubjectRegionOptions(const SubjectRegionOptions& options);
 struct SubjectRegion {
   bool valid = false;
   Eigen::Vector2d head_centre = Eigen::Vector2d::Zero();
+  /// The landmark centre (what E_f puts at H) [px]: the middle of the face,
+  /// below the head ellipse's centre. NaN when not measured (a region built
+  /// by hand): the layer blend then holds no face core.
+  Eigen::Vector2d face_centre = Eigen::Vector2d::Constant(NAN);
   Eigen::Vector2d head_axes = Eigen::Vector2d::Zero();  ///< half-axes [px]
   Eigen::Vector2d chin = Eigen::Vector2d::Zero();
   double jaw_width = 0.0;    ///< [px]
@@ -58,6 +65,18 @@ struct SubjectRegion {
   /// inside, positive outside (exact for circles; for ellipses scaled by the
   /// smaller half-axis, which keeps the band no narrower than asked).
   double SignedDistance(const Eigen::Vector2d& p) const;
+
+  /// The signed distance to the outline at every vertex of a grid (vertex
+  /// columns at u, rows at v, as a mesh's) into `*sd` [px]. Unlike
+  /// SignedDistance it is right inside where the shapes overlap (under the
+  /// chin the nearer of the two outlines lies inside the other shape, and
+  /// SignedDistance underestimates the depth by up to the neck's width):
+  /// inside, the region is rasterized at a quarter of the grid's cell and
+  /// distance-transformed, made conservative by half the raster's diagonal
+  /// and never shallower than SignedDistance; outside it is SignedDistance.
+  /// No vertex reads deeper inside than it is.
+  void GridDistances(const std::vector<double>& u, const std::vector<double>& v,
+                     std::vector<double>* sd) const;
 };
 
 /// Builds the subject region from this frame's landmarks, mapped into the

@@ -85,6 +85,11 @@ struct StabilizerFrame {
   bool has_target = false;
   Eigen::Vector2d H = Eigen::Vector2d::Zero();
   Eigen::Vector2d C = Eigen::Vector2d::Zero();
+  /// Layered mode: the radius of the disc, around where the background
+  /// layer shows the face, that H was held within (subject_reach, or the
+  /// warp's SetReachLimit if less, times the jaw width) [normalized]; 0 when
+  /// H was not held (no background layer, no target).
+  double subject_reach = 0.0;
   /// Weights in effect (base weights times the dynamic factors).
   StabilizerWeights weights;
   WeightFactors factors;
@@ -146,6 +151,13 @@ class Stabilizer {
   /// Replaces the tunable options (weights, terms, dynamic, solver, head,
   /// gyro_only) from the next frame on. Validated; on error nothing changes.
   Status UpdateOptions(const StabilizerOptions& options);
+
+  /// Layered mode: the largest offset between the layers at the face that
+  /// the warp's band absorbs now, in jaw widths (the pipeline passes the
+  /// last frame's LayerBlendReport::reach_px over the jaw width). H is held
+  /// within min(subject_reach, this) of where the background layer shows the
+  /// face. <= 0: subject_reach alone.
+  void SetReachLimit(double jaw_widths) { reach_limit_ = jaw_widths; }
 
   /// Forgets the trajectory (time jumped, new epoch). Counters are kept.
   void reset();
@@ -272,6 +284,8 @@ class Stabilizer {
   // (subject_reach_lowpass_hz), and the frame (stats_.frames) it was last
   // fed: it restarts after a frame without it.
   SlowMotionFilter reach_anchor_;
+  // SetReachLimit's bound on subject_reach [jaw widths]; <= 0: none.
+  double reach_limit_ = 0.0;
   uint64_t reach_anchor_frame_ = 0;
   bool reach_anchor_fed_ = false;
 };
