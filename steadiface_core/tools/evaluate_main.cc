@@ -42,6 +42,44 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
+// Per frame of a layered run: the time, the true head centre through the
+// background layer's pose (where the background layer shows it) and
+// whether it is in view [output px], and the radius of the disc the
+// stabilizer held H within around where it saw the face there (0: none)
+// [output px]: the tube any head that leaves the background alone must stay
+// in, for scripts/analysis/reach_bound.py.
+steadiface::Status WriteReachTube(const steadiface::sim::Simulator& sim,
+                                  const steadiface::PipelineOptions& po,
+                                  const std::vector<steadiface::StabilizerFrame>& frames,
+                                  const std::string& path) {
+  std::unique_ptr<steadiface::eval::Scorecard> card;
+  steadiface::Status s = steadiface::eval::MakeScorecard(sim, po, &card);
+  steadiface::CameraModel model;
+  if (s.ok()) s = steadiface::CameraModel::Create(sim.intrinsics(), po.camera, &model);
+  steadiface::OutputGeometry output;
+  if (s.ok()) s = steadiface::OutputGeometry::Create(model, po.warp.output, &output);
+  if (!s.ok()) return s;
+  // Output px per normalized unit (the output map is a scale and a shift).
+  const double scale = (output.VirtualToOutputPixel(Eigen::Vector2d(1.0, 0.0)) -
+                        output.VirtualToOutputPixel(Eigen::Vector2d::Zero()))
+                           .norm();
+  std::ofstream csv(path);
+  csv << "t,bg_head_x,bg_head_y,head_valid,reach_px\n";
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const steadiface::StabilizerFrame& f = frames[i];
+    steadiface::eval::FrameWarp w;
+    w.kind = steadiface::eval::FrameWarp::Kind::kPose;
+    w.R_v = f.background.valid ? f.background.R_v : f.R_v;
+    w.t = f.background.valid ? f.background.t : f.t;
+    w.rows = f.rows;
+    card->Add(static_cast<int>(i), w);
+    const auto& p = card->samples().back();
+    csv << p.t << "," << p.head_out.x() << "," << p.head_out.y() << "," << p.head_valid << ","
+        << f.subject_reach * scale << "\n";
+  }
+  return csv ? steadiface::Status::Ok() : steadiface::Status::Error("cannot write " + path);
+}
+
 // Per frame: the time and the radii of eval::FeasibleOffsets in 72
 // directions (5 degrees apart, from +x towards +y) [input px].
 steadiface::Status WriteFeasibleSet(
@@ -123,6 +161,11 @@ int Usage() {
                "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
                "         per frame, the crop-window shifts the margin allows, rolling shutter\n"
                "         included, in 72 directions [input px], for scripts/analysis/crop_bound.py)\n"
+               "       [--face-core CELLS] (warp/layered/face_core)\n"
+               "       [--reach-tube] (layered: also reach_<preset>_<method>.csv: per frame,\n"
+               "         the true head through the background layer's pose and the radius\n"
+               "         H was held within there, both in output px; for\n"
+               "         scripts/analysis/reach_bound.py)\n"
                "       [--feasible-roll MAX] (with --feasible-set, also\n"
                "         feasible_<preset>_<method>_roll.csv: the same for a window that also\n"
                "         rolls, every 0.025 rad within +-MAX, and the true head's move when it\n"
@@ -156,6 +199,7 @@ int main(int argc, char** argv) {
   double reach_hold = NAN;       // stabilizer.subject_reach_hold (NaN: default)
   bool feasible_set = false;     // --feasible-set: write feasible_<preset>_<method>.csv
   double feasible_roll = 0.0;    // --feasible-roll MAX [rad]; 0: none
+  bool reach_tube = false;       // --reach-tube: write reach_<preset>_<method>.csv
   steadiface::CommandLine cl;
   cl.String("--data", &data).String("--out", &out_dir);
   cl.Value("--presets", "a comma-separated list",
@@ -172,6 +216,7 @@ int main(int argc, char** argv) {
   cl.Double("--feasible-roll", &feasible_roll).Double("--band", &blend.band_width);
   cl.Double("--band-inside", &blend.band_inside);
   cl.Double("--outline-margin", &blend.outline_margin_cells);
+  cl.Double("--face-core", &blend.face_core_cells).Flag("--reach-tube", &reach_tube);
   cl.Double("--max-offset", &blend.max_offset);
   cl.ClearFlag("--yield-to-background", &blend.yield_to_subject);
   cl.Double("--offset-lowpass", &blend.offset_lowpass_hz);
@@ -377,6 +422,10 @@ int main(int argc, char** argv) {
             } else {
               csv << ",nan,nan,nan\n";  // no stabilizer (input)
             }
+          }
+          if (reach_tube && m == Method::kSteadifaceLayered && s.ok()) {
+            s = WriteReachTube(*sim, po, stab_frames,
+                               out_dir + "/reach_" + preset + "_" + name + ".csv");
           }
           if (feasible_set && !stab_frames.empty()) {
             std::vector<Eigen::Vector2d> heads;  // the true head in the input
