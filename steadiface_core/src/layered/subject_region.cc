@@ -115,7 +115,8 @@ void SubjectRegion::GridDistances(const std::vector<double>& u, const std::vecto
       const double a = px - ix, b = py - iy;
       const double d = ((1 - a) * (1 - b) * at(ix, iy) + a * (1 - b) * at(ix + 1, iy) +
                         (1 - a) * b * at(ix, iy + 1) + a * b * at(ix + 1, iy + 1)) * res;
-      // Conservative: less the raster's half diagonal and the chamfer's 2 %.
+      // Less the raster's half diagonal and the chamfer's 2 % (the filled
+      // outline's covered pixels can still leave it up to ~1 px deep).
       out = -std::max(-analytic, 0.98 * d - 0.5 * std::sqrt(2.0) * res);
     }
   }

@@ -72,9 +72,12 @@ struct SubjectRegion {
   /// chin the nearer of the two outlines lies inside the other shape, and
   /// SignedDistance underestimates the depth by up to the neck's width):
   /// inside, the region is rasterized at a quarter of the grid's cell and
-  /// distance-transformed, made conservative by half the raster's diagonal
-  /// and never shallower than SignedDistance; outside it is SignedDistance.
-  /// No vertex reads deeper inside than it is.
+  /// distance-transformed, less half the raster's diagonal and never
+  /// shallower than SignedDistance; outside it is SignedDistance. Inside, it
+  /// is within the raster's resolution of the true depth and at most about
+  /// 1 px deeper (the rasterized outline covers the pixels it touches). An
+  /// outline more than one cell beyond the grid (shoulders below the frame)
+  /// is not seen: the depth there is to the outline within the grid.
   void GridDistances(const std::vector<double>& u, const std::vector<double>& v,
                      std::vector<double>* sd) const;
 };

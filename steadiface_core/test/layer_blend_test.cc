@@ -1,7 +1,7 @@
-// The layered warp (issue 15) piece by piece against closed forms: the
-// subject region's geometry and blend ramp, and the mesh optimization that
-// joins two layers (LayerBlend) on meshes whose layers differ by a known
-// translation.
+// The mesh optimization that joins the layered warp's two layers
+// (LayerBlend), piece by piece against closed forms, on meshes whose layers
+// differ by a known translation: the band, the cap, the pulls, the face's
+// core and continuity as the face moves.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,156 +10,22 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include "layered_test_util.h"
 #include "steadiface_core/layered/layer_blend.h"
 #include "steadiface_core/layered/subject_region.h"
 
 namespace steadiface {
 namespace {
 
-// A 33 x 19 vertex grid over a 640 x 360 output.
-struct Grid {
-  std::vector<double> u, v;
-  Grid() {
-    for (int i = 0; i <= 32; ++i) u.push_back(i * 639.0 / 32);
-    for (int j = 0; j <= 18; ++j) v.push_back(j * 359.0 / 18);
-  }
-  int n() const { return static_cast<int>(u.size() * v.size()); }
-  Eigen::Vector2d At(int k) const {
-    return Eigen::Vector2d(u[k % u.size()], v[k / u.size()]);
-  }
-  // The background layer: the output shifted into an 840 x 460 input.
-  std::vector<Eigen::Vector2f> Background() const {
-    std::vector<Eigen::Vector2f> b(n());
-    for (int k = 0; k < n(); ++k)
-      b[k] = (At(k) + Eigen::Vector2d(100, 50)).cast<float>();
-    return b;
-  }
-};
-
-// A head of jaw width 100 px centred at (320, 150), shoulders below.
-SubjectRegion Region(double blend = 1.0) {
-  SubjectRegion r;
-  r.valid = true;
-  r.jaw_width = 100;
-  r.face_height = 90;
-  r.chin = Eigen::Vector2d(320, 215);
-  r.head_centre = Eigen::Vector2d(320, 150);
-  r.head_axes = Eigen::Vector2d(70, 75);
-  r.torso = true;
-  r.neck_half_width = 35;
-  r.shoulder_axes = Eigen::Vector2d(150, 180);
-  r.shoulder_centre = r.chin + Eigen::Vector2d(0, 0.6 * 90 + 180);
-  r.blend = blend;
-  return r;
-}
-
-// Region() scaled to a jaw of `jaw` px about its head centre, with the
-// landmark centre 0.3 jaw widths below the head ellipse's centre.
-SubjectRegion Head(double jaw) {
-  SubjectRegion r = Region();
-  const double k = jaw / r.jaw_width;
-  auto scale = [&](const Eigen::Vector2d& p) {
-    return Eigen::Vector2d(r.head_centre + k * (p - r.head_centre));
-  };
-  r.chin = scale(r.chin);
-  r.shoulder_centre = scale(r.shoulder_centre);
-  r.jaw_width *= k;
-  r.face_height *= k;
-  r.head_axes *= k;
-  r.neck_half_width *= k;
-  r.shoulder_axes *= k;
-  r.face_centre = r.head_centre + Eigen::Vector2d(0.0, 0.3 * jaw);
-  return r;
-}
-
-// A band that straddles the outline, a whole-frame shift for the offset's
-// slow part and the face first where the layers cannot be joined: the
-// mechanisms the default (a band inside the subject that never bends the
-// background) switches off, still options.
-LayerBlendOptions Straddling() {
-  LayerBlendOptions o;
-  o.band_width = 0.5;
-  o.band_inside = 0.5;
-  o.outline_margin_cells = 0.0;
-  o.offset_lowpass_hz = 0.1;
-  o.yield_to_subject = true;
-  return o;
-}
-
-LayerBlendOptions NoSlowShift() {
-  LayerBlendOptions o = Straddling();
-  o.offset_lowpass_hz = 0.0;  // the band absorbs the whole offset
-  return o;
-}
-
-// The background-first variant (the subject gives way).
-LayerBlendOptions YieldingToTheBackground(LayerBlendOptions o) {
-  o.yield_to_subject = false;
-  return o;
-}
-
-std::vector<Eigen::Vector2f> Shifted(const std::vector<Eigen::Vector2f>& b,
-                                     const Eigen::Vector2d& T) {
-  std::vector<Eigen::Vector2f> s = b;
-  for (auto& p : s) p += T.cast<float>();
-  return s;
-}
-
-TEST(SubjectRegionTest, SignedDistanceCoversHeadNeckAndShouldersOnly) {
-  const SubjectRegion r = Region();
-  EXPECT_LT(r.SignedDistance({320, 150}), -60.0);  // head centre
-  EXPECT_LT(r.SignedDistance({320, 240}), 0.0);    // neck
-  EXPECT_LT(r.SignedDistance({200, 350}), 0.0);    // shoulder
-  EXPECT_GT(r.SignedDistance({100, 100}), 100.0);  // background beside the head
-  // Circle-exact: a point 30 px right of the head ellipse's side.
-  EXPECT_NEAR(r.SignedDistance({320 + 70 + 30, 150}), 30.0, 1.0);
-}
-
-TEST(SubjectRegionTest, BlendStartsAtItsTargetThenRampsAtMostDtOverRamp) {
-  SubjectRegionOptions o;
-  o.ramp_s = 0.5;
-  SubjectRegionTracker t(o);
-  CameraModel model;
-  ASSERT_TRUE(CameraModel::Create(IntrinsicsFromHorizontalFov(640, 360, 1.1),
-                                  CameraModelOptions(), &model)
-                  .ok());
-  OutputGeometry out;
-  ASSERT_TRUE(OutputGeometry::Create(model, OutputOptions(), &out).ok());
-  const RowRotations rows(Eigen::Quaterniond::Identity(), 360);
-  // A frontal face: 68 points on a 0.2-wide ellipse in normalized units
-  // (jaw 0-16 along its lower half, brows 17-26 above the centre).
-  FaceObservation face;
-  face.valid = true;
-  for (int i = 0; i < 68; ++i) {
-    const double a = i <= 16 ? M_PI * i / 16.0 : -0.5 * M_PI + 0.05 * (i - 40);
-    face.landmarks.emplace_back(0.5 + 0.1 * std::cos(a),
-                                0.5 + 0.12 * std::sin(a));
-  }
-  face.landmark_rows.assign(68, 180.0);
-  const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
-  const SubjectRegion& first =
-      t.Update(model, out, I, Eigen::Vector2d::Zero(), rows, &face, 1.0, 0.0);
-  ASSERT_TRUE(first.valid);
-  EXPECT_DOUBLE_EQ(first.blend, 1.0);  // no previous output to jump from
-  // The output shows the middle 70 % of the width, magnified 1/0.7: the jaw
-  // spans 0.2 of the input width = 0.2 * 640 / 0.7 output px.
-  EXPECT_NEAR(first.jaw_width, 0.2 * 640 / 0.7, 3.0);
-  EXPECT_NEAR(first.head_centre.x(), 319.5, 2.0);
-  // The face is lost: the blend ramps to 0 by at most dt / ramp per frame.
-  const double dt = 1.0 / 30;
-  double previous = first.blend;
-  int frames = 0;
-  while (t.region().blend > 0.0 && frames < 100) {
-    const SubjectRegion& r = t.Update(model, out, I, Eigen::Vector2d::Zero(),
-                                      rows, nullptr, 0.0, dt);
-    EXPECT_LE(previous - r.blend, dt / 0.5 + 1e-12);
-    EXPECT_DOUBLE_EQ(r.blend_step, previous - r.blend);
-    EXPECT_TRUE(r.valid);  // the last region is kept while it fades
-    previous = r.blend;
-    ++frames;
-  }
-  EXPECT_NEAR(frames, 15, 1);  // 0.5 s at 30 fps (rounding may add one)
-}
+using testing_util::BackgroundUnbent;
+using testing_util::Grid;
+using testing_util::Head;
+using testing_util::NoSlowShift;
+using testing_util::OffsetAt;
+using testing_util::Region;
+using testing_util::Shifted;
+using testing_util::Straddling;
+using testing_util::YieldingToTheBackground;
 
 // Layers that differ by a translation T: the core moves by T, the
 // background beyond the band not at all, the band in between, with no
@@ -254,44 +120,6 @@ TEST(LayerBlendTest, TheDefaultBandNeverBendsTheBackground) {
     EXPECT_DOUBLE_EQ(rep.distortion_keep, 1.0);
     EXPECT_DOUBLE_EQ(rep.shift_px, 0.0);  // nothing moves the whole frame
   }
-}
-
-// The joined mesh's offset from the background layer at output point p
-// (bilinear in its cell, as the sampler interpolates).
-Eigen::Vector2d OffsetAt(const Grid& g, const std::vector<Eigen::Vector2f>& out,
-                         const std::vector<Eigen::Vector2f>& background, const Eigen::Vector2d& p) {
-  const int cols = static_cast<int>(g.u.size());
-  int i = 0, j = 0;
-  while (i + 2 < cols && g.u[i + 1] <= p.x()) ++i;
-  while (j + 2 < static_cast<int>(g.v.size()) && g.v[j + 1] <= p.y()) ++j;
-  const double a = (p.x() - g.u[i]) / (g.u[i + 1] - g.u[i]);
-  const double b = (p.y() - g.v[j]) / (g.v[j + 1] - g.v[j]);
-  auto d = [&](int ii, int jj) {
-    const int k = jj * cols + ii;
-    return (out[k] - background[k]).cast<double>().eval();
-  };
-  return (1 - a) * (1 - b) * d(i, j) + a * (1 - b) * d(i + 1, j) + (1 - a) * b * d(i, j + 1) +
-         a * b * d(i + 1, j + 1);
-}
-
-// True when every cell that reaches outside the region's outline keeps all
-// four vertices exactly on the background layer.
-bool BackgroundUnbent(const Grid& g, const SubjectRegion& region,
-                      const std::vector<Eigen::Vector2f>& out,
-                      const std::vector<Eigen::Vector2f>& background) {
-  const int cols = static_cast<int>(g.u.size());
-  for (int j = 0; j + 1 < static_cast<int>(g.v.size()); ++j) {
-    for (int i = 0; i + 1 < cols; ++i) {
-      const int c[4] = {j * cols + i, j * cols + i + 1, (j + 1) * cols + i,
-                        (j + 1) * cols + i + 1};
-      bool reaches_out = false;
-      for (int k : c) reaches_out = reaches_out || region.SignedDistance(g.At(k)) > 0.0;
-      for (int k : c) {
-        if (reaches_out && out[k] != background[k]) return false;
-      }
-    }
-  }
-  return true;
 }
 
 // The face's own cell follows the subject layer (face_core_cells). The
@@ -671,10 +499,14 @@ TEST(LayerBlendTest, RejectsBadOptions) {
   EXPECT_FALSE(m.ok());
   EXPECT_NE(m.message().find("min_cell_ratio"), std::string::npos)
       << m.message();
+  o = LayerBlendOptions();
+  o.face_core_cells = -1.0;
+  const Status c = ValidateLayerBlendOptions(o);
+  EXPECT_FALSE(c.ok());
+  EXPECT_NE(c.message().find("face_core"), std::string::npos) << c.message();
   SubjectRegionOptions r;
   r.ramp_s = 0.0;
   EXPECT_FALSE(ValidateSubjectRegionOptions(r).ok());
 }
-
 }  // namespace
 }  // namespace steadiface
