@@ -42,6 +42,16 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
+// The camera model and output geometry a pipeline with `po` builds for
+// `intrinsics`.
+steadiface::Status MakeOutputGeometry(const steadiface::CameraIntrinsics& intrinsics,
+                                      const steadiface::PipelineOptions& po,
+                                      steadiface::CameraModel* model,
+                                      steadiface::OutputGeometry* output) {
+  const steadiface::Status s = steadiface::CameraModel::Create(intrinsics, po.camera, model);
+  return s.ok() ? steadiface::OutputGeometry::Create(*model, po.warp.output, output) : s;
+}
+
 // Per frame of a layered run: the time, the true head centre through the
 // background layer's pose (where the background layer shows it) and
 // whether it is in view [output px], and the radius of the disc the
@@ -55,9 +65,8 @@ steadiface::Status WriteReachTube(const steadiface::sim::Simulator& sim,
   std::unique_ptr<steadiface::eval::Scorecard> card;
   steadiface::Status s = steadiface::eval::MakeScorecard(sim, po, &card);
   steadiface::CameraModel model;
-  if (s.ok()) s = steadiface::CameraModel::Create(sim.intrinsics(), po.camera, &model);
   steadiface::OutputGeometry output;
-  if (s.ok()) s = steadiface::OutputGeometry::Create(model, po.warp.output, &output);
+  if (s.ok()) s = MakeOutputGeometry(sim.intrinsics(), po, &model, &output);
   if (!s.ok()) return s;
   // Output px per normalized unit (the output map is a scale and a shift).
   const double scale = (output.VirtualToOutputPixel(Eigen::Vector2d(1.0, 0.0)) -
@@ -89,9 +98,8 @@ steadiface::Status WriteFeasibleSet(
     const std::string& path, const std::vector<Eigen::Vector2d>& heads,
     double max_roll) {
   steadiface::CameraModel model;
-  steadiface::Status s = steadiface::CameraModel::Create(intrinsics, po.camera, &model);
   steadiface::OutputGeometry output;
-  if (s.ok()) s = steadiface::OutputGeometry::Create(model, po.warp.output, &output);
+  const steadiface::Status s = MakeOutputGeometry(intrinsics, po, &model, &output);
   if (!s.ok()) return s;
   const steadiface::eval::FeasibleOffsets feasible(
       model, output, po.stabilizer.terms.protrusion_samples_per_edge);
