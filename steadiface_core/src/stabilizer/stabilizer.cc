@@ -6,22 +6,15 @@
 #include <sstream>
 #include <vector>
 
-#include <ceres/problem.h>
-#include <ceres/solver.h>
-
-#include "steadiface_core/common/ceres_compat.h"
 #include "steadiface_core/common/so3.h"
-#include "steadiface_core/stabilizer/distortion_cost.h"
 #include "steadiface_core/stabilizer/face_in_camera.h"
-#include "steadiface_core/stabilizer/fitting_cost.h"
-#include "steadiface_core/stabilizer/following_cost.h"
-#include "steadiface_core/stabilizer/protrusion_cost.h"
-#include "steadiface_core/stabilizer/rotation_smoothness_cost.h"
-#include "steadiface_core/stabilizer/stall_tolerant_solve.h"
-#include "steadiface_core/stabilizer/translation_smoothness_cost.h"
+#include "stabilizer/pose_problem.h"
 
 namespace steadiface {
 namespace {
+
+using stabilizer_internal::Clock;
+using stabilizer_internal::MsSince;
 
 // The reach anchor's frequency (a valid one while the anchor is off).
 double ReachAnchorHz(const StabilizerOptions& o) {
@@ -32,13 +25,6 @@ double ReachAnchorHz(const StabilizerOptions& o) {
 Eigen::Vector2d ClampNorm(const Eigen::Vector2d& v, double r) {
   const double n = v.norm();
   return n > r && n > 0.0 ? Eigen::Vector2d(v * (r / n)) : v;
-}
-
-using Clock = std::chrono::steady_clock;
-
-double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start)
-      .count();
 }
 
 bool FaceUsable(const FaceObservation* face, const StabilizerOptions& o) {
@@ -58,18 +44,6 @@ bool FaceUsable(const FaceObservation* face, const StabilizerOptions& o) {
     if (!std::isfinite(y)) return false;
   }
   return true;
-}
-
-// Sum of squared residuals of a set of blocks (= w * E for that term).
-double TermEnergy(ceres::Problem* problem,
-                  const std::vector<ceres::ResidualBlockId>& blocks) {
-  if (blocks.empty()) return 0.0;
-  ceres::Problem::EvaluateOptions eo;
-  eo.residual_blocks = blocks;
-  eo.apply_loss_function = false;
-  double cost = 0.0;
-  if (!problem->Evaluate(eo, &cost, nullptr, nullptr, nullptr)) return NAN;
-  return 2.0 * cost;
 }
 
 }  // namespace
@@ -128,17 +102,6 @@ void Stabilizer::reset() {
   reach_anchor_fed_ = false;
   ++stats_.resets;
 }
-
-// One frame's Eq. 5 problem: the parameter blocks and each term's residual
-// blocks, kept after the solve to evaluate the energies at the final pose.
-struct Stabilizer::PoseProblem {
-  double q_block[4];
-  double t_block[2];
-  ceres::Problem problem;
-  std::vector<ceres::ResidualBlockId> b_fit, b_dist, b_follow, b_rot, b_trans, b_prot;
-  Eigen::Map<Eigen::Vector4d> q() { return Eigen::Map<Eigen::Vector4d>(q_block); }
-  Eigen::Map<Eigen::Vector2d> t() { return Eigen::Map<Eigen::Vector2d>(t_block); }
-};
 
 Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
                            const RowTiming& timing,
@@ -395,163 +358,6 @@ void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, double d
   f->H = seen.centre + ClampNorm(H - seen.centre, reach);
 }
 
-void Stabilizer::SolveStep(Time stamp, const OrientationTimeline& timeline,
-                           const RowTiming& timing, const LayerState& layer,
-                           const FaceObservation* fit_face, const StabilizerWeights& w,
-                           double dt, PoseProblem* pp, Eigen::Quaterniond* R_v,
-                           Eigen::Vector2d* t, StabilizerFrame* f, StabilizerStats* stats) {
-  // Solve (Eq. 5) from the initial pose in *R_v, *t.
-  const auto t_solve = Clock::now();
-  const Eigen::Quaterniond R_v0 = *R_v;
-  const Eigen::Vector2d t0 = *t;
-  pp->q() = R_v0.coeffs();
-  pp->t() = t0;
-  ceres_compat::AddQuaternionBlock(&pp->problem, pp->q_block);
-  pp->problem.AddParameterBlock(pp->t_block, 2);
-  AddFitTerms(fit_face, w, *f, pp);
-  AddRotationTerms(stamp, timeline, timing, layer, w, dt, *f, pp);
-  AddOffsetTerms(layer, w, R_v0, t0, *f, pp);
-  RunSolve(R_v0, t0, pp, R_v, t, f, stats);
-  f->solver.time_ms = MsSince(t_solve);
-  f->timings.solve_ms = f->solver.time_ms;
-}
-
-void Stabilizer::AddFitTerms(const FaceObservation* fit_face, const StabilizerWeights& w,
-                             const StabilizerFrame& frame, PoseProblem* pp) const {
-  // E_f (Eq. 6), one block per landmark, each through its own row.
-  const StabilizerFrame* f = &frame;
-  ceres::Problem& problem = pp->problem;
-  const double f_r = model_.real_focal(), f_v = model_.virtual_focal();
-  if (f->has_target && w.fit > 0.0) {
-    const FaceObservation* face = fit_face;
-    const double s = std::sqrt(w.fit / face->landmarks.size());
-    for (size_t i = 0; i < face->landmarks.size(); ++i) {
-      const Eigen::Quaterniond R_row =
-          face->landmark_rows.empty()
-              ? f->R_r
-              : AlignSign(f->rows.At(face->landmark_rows[i]), f->R_r);
-      pp->b_fit.push_back(problem.AddResidualBlock(
-          FittingCost::Create(face->landmarks[i], R_row, f->H, f_r, f_v, s),
-          nullptr, pp->q_block, pp->t_block));
-    }
-  }
-}
-
-void Stabilizer::AddRotationTerms(Time stamp, const OrientationTimeline& timeline,
-                                  const RowTiming& timing, const LayerState& layer,
-                                  const StabilizerWeights& w, double dt,
-                                  const StabilizerFrame& frame, PoseProblem* pp) const {
-  // E_d (Eq. 7), E_o (Eq. 8) and E_r (Eq. 9).
-  const StabilizerFrame* f = &frame;
-  ceres::Problem& problem = pp->problem;
-  if (w.distortion > 0.0) {
-    pp->b_dist.push_back(problem.AddResidualBlock(
-        DistortionCost::Create(f->R_r, options_.terms.distortion_threshold_rad,
-                               options_.terms.distortion_slope,
-                               std::sqrt(w.distortion)),
-        nullptr, pp->q_block));
-  }
-  if (w.follow > 0.0) {
-    pp->b_follow.push_back(problem.AddResidualBlock(
-        FollowingCost::Create(f->R_r, std::sqrt(w.follow)), nullptr, pp->q_block));
-  }
-  if (layer.history >= 1) {
-    const Eigen::Quaterniond prev_delta =
-        (layer.R_v_prev * layer.R_v_prev_prev.conjugate()).normalized();
-    Eigen::Quaterniond c0_target = layer.R_v_prev;
-    if (options_.intentional_window_s > 0.0) {
-      // The real camera's mean rotation per frame over the window.
-      const double W = options_.intentional_window_s;
-      Eigen::Quaterniond R_old;
-      if (QuerySucceeded(timeline.RealRotation(
-              timing.RowTime(stamp, 0.5 * (timing.height() - 1)) - FromSeconds(W),
-              &R_old))) {
-        const Eigen::Vector3d rate = LogSO3(f->R_r * R_old.conjugate()) / W;
-        c0_target = (ExpSO3(rate * dt) * layer.R_v_prev).normalized();
-      }
-    }
-    pp->b_rot.push_back(problem.AddResidualBlock(
-        RotationSmoothnessCost::Create(c0_target, layer.R_v_prev, prev_delta,
-                                       layer.history >= 2, std::sqrt(w.rotation_c0),
-                                       std::sqrt(w.rotation_c1)),
-        nullptr, pp->q_block));
-  }
-}
-
-void Stabilizer::AddOffsetTerms(const LayerState& layer, const StabilizerWeights& w,
-                                const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
-                                const StabilizerFrame& frame, PoseProblem* pp) {
-  // E_t (Eq. 10) and E_p (Eq. 11, at the initial pose's rows).
-  const StabilizerFrame* f = &frame;
-  ceres::Problem& problem = pp->problem;
-  // On the first frame the offset's only prior is C0 towards 0.
-  pp->b_trans.push_back(problem.AddResidualBlock(
-      TranslationSmoothnessCost::Create(
-          layer.history >= 1 ? layer.t_prev : Eigen::Vector2d::Zero(), layer.t_prev_prev,
-          layer.history >= 2, std::sqrt(w.translation_c0),
-          std::sqrt(w.translation_c1)),
-      nullptr, pp->t_block));
-  const double shrink_px =
-      options_.terms.protrusion_shrink * model_.intrinsics().width;
-  if (w.protrusion > 0.0) {
-    const ProtrusionReport at_init =
-        protrusion_.Check(R_v0, t0, f->rows, shrink_px);
-    std::vector<Eigen::Quaterniond> R_samples;
-    R_samples.reserve(at_init.rows.size());
-    for (double y : at_init.rows) R_samples.push_back(f->rows.At(y));
-    pp->b_prot.push_back(problem.AddResidualBlock(
-        ProtrusionCost::Create(&protrusion_, std::move(R_samples), shrink_px,
-                               options_.terms.protrusion_alpha, w.protrusion),
-        nullptr, pp->q_block, pp->t_block));
-  }
-
-}
-
-void Stabilizer::RunSolve(const Eigen::Quaterniond& R_v0, const Eigen::Vector2d& t0,
-                          PoseProblem* pp, Eigen::Quaterniond* R_v, Eigen::Vector2d* t,
-                          StabilizerFrame* f, StabilizerStats* stats) const {
-  ceres::Problem& problem = pp->problem;
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = options_.solver.max_iterations;
-  so.function_tolerance = options_.solver.function_tolerance;
-  so.gradient_tolerance = options_.solver.gradient_tolerance;
-  so.max_solver_time_in_seconds = options_.solver.max_time_s;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  so.minimizer_progress_to_stdout = false;
-  ceres::Solver::Summary summary;
-  // A time cap that runs out before the first step (a stall) would leave the
-  // initial pose, the previous warp with this frame's shake in it: the
-  // solve is then rerun under the iteration cap alone.
-  if (StallTolerantSolve(so, &problem,
-                         [&] {
-                           pp->q() = R_v0.coeffs();
-                           pp->t() = t0;
-                         },
-                         &summary)) {
-    f->solver.restarted = true;
-    ++stats->solver_restarts;
-  }
-  f->solver.ran = true;
-  f->solver.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  f->solver.termination = ceres::TerminationTypeToString(summary.termination_type);
-  f->solver.initial_cost = summary.initial_cost;
-  f->solver.final_cost = summary.final_cost;
-  const Eigen::Quaterniond q_sol(pp->q_block[3], pp->q_block[0], pp->q_block[1],
-                                 pp->q_block[2]);
-  const Eigen::Vector2d t_sol = pp->t();
-  f->solver.usable = summary.IsSolutionUsable() && q_sol.coeffs().allFinite() &&
-                     t_sol.allFinite() && std::isfinite(summary.final_cost);
-  if (f->solver.usable) {
-    *R_v = q_sol.normalized();
-    *t = t_sol;
-  } else {
-    f->flags.solver_failed = true;
-    ++stats->solver_failures;
-  }
-}
-
 void Stabilizer::ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v,
                                 Eigen::Vector2d* t, StabilizerFrame* f, StabilizerStats* stats) {
   // Protrusion handling (§4.4): binary search towards the real pose, else
@@ -599,19 +405,6 @@ void Stabilizer::ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v
   }
   if (f->flags.undefined_pixels) ++stats->undefined_frames;
   f->timings.protrusion_ms = MsSince(t_prot);
-}
-
-void Stabilizer::EnergiesStep(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
-                              PoseProblem* pp, StabilizerFrame* f) const {
-  // Energies at the final pose.
-  pp->q() = R_v.coeffs();
-  pp->t() = t;
-  f->energies.fit = TermEnergy(&pp->problem, pp->b_fit);
-  f->energies.distortion = TermEnergy(&pp->problem, pp->b_dist);
-  f->energies.follow = TermEnergy(&pp->problem, pp->b_follow);
-  f->energies.rotation = TermEnergy(&pp->problem, pp->b_rot);
-  f->energies.translation = TermEnergy(&pp->problem, pp->b_trans);
-  f->energies.protrusion = TermEnergy(&pp->problem, pp->b_prot);
 }
 
 void Stabilizer::BackgroundLayer(Time stamp, const OrientationTimeline& timeline,

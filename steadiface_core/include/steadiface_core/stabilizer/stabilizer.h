@@ -184,7 +184,7 @@ class Stabilizer {
     bool has_H = false;
     Eigen::Vector2d H_prev = Eigen::Vector2d::Zero();
   };
-  struct PoseProblem;  // one frame's Ceres problem (stabilizer.cc)
+  struct PoseProblem;  // one frame's Ceres problem (src/stabilizer/pose_problem.h)
 
   // Process(), step by step, in this order.
   // Row rotations: validates the stamp, builds the per-row real rotations
