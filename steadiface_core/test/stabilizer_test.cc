@@ -1,7 +1,7 @@
 // The whole stabilizer on ground-truth sequences (simulated landmarks and
 // gyro): jitter against the input and gyro-only, face loss, protrusion,
-// determinism, the background layer, ablations. Its terms one by one are in
-// stabilizer_terms_test.cc.
+// determinism, the background layer. Its terms one by one are in
+// stabilizer_terms_test.cc, their ablations in stabilizer_ablation_test.cc.
 #include "steadiface_core/stabilizer/stabilizer.h"
 
 #include <algorithm>
@@ -14,6 +14,7 @@
 #include "steadiface_core/common/so3.h"
 #include "steadiface_core/sim/landmark_sequence.h"
 #include "steadiface_core/stabilizer/face_in_camera.h"
+#include "stabilizer_test_util.h"
 #include "test_util.h"
 
 namespace steadiface {
@@ -21,117 +22,14 @@ namespace {
 
 using testing_util::At;
 using testing_util::Model640x360;
+using testing_util::Print;
+using testing_util::RunResult;
+using testing_util::RunSequence;
+using testing_util::ViolentShake;
+using testing_util::Walk;
 
 // ---------- Stabilizer on ground-truth sequences ----------
 
-struct Jitter {
-  double head_px = 0.0, background_px = 0.0;
-};
-
-// RMS of x - (centred moving average over `win` frames): a ~fps/win Hz
-// high-pass, on the frames where the whole window exists.
-double HighPassRms(const std::vector<Eigen::Vector2d>& x, int win) {
-  double s2 = 0.0;
-  int n = 0;
-  for (int i = win / 2; i + win / 2 < static_cast<int>(x.size()); ++i) {
-    Eigen::Vector2d avg = Eigen::Vector2d::Zero();
-    for (int j = i - win / 2; j <= i + win / 2; ++j) avg += x[j];
-    avg /= (2 * (win / 2) + 1);
-    s2 += (x[i] - avg).squaredNorm();
-    ++n;
-  }
-  return std::sqrt(s2 / std::max(1, n));
-}
-
-struct RunResult {
-  Jitter input, output;
-  int undefined = 0, fallbacks = 0, frames = 0;
-  std::vector<StabilizerFrame> frames_out;
-};
-
-// `reach_limit` > 0: Stabilizer::SetReachLimit before every frame.
-RunResult RunSequence(const CameraModel& m, const sim::LandmarkSequence& seq,
-              StabilizerOptions so, double reach_limit = 0.0) {
-  std::unique_ptr<Stabilizer> stab;
-  OutputOptions oo;
-  oo.crop_ratio = 0.1;
-  EXPECT_TRUE(Stabilizer::Create(m, oo, so, &stab).ok());
-  OrientationTimeline tl{OrientationTimelineOptions()};
-  size_t g = 0;
-  RunResult rr;
-  std::vector<Eigen::Vector2d> head_in, head_out, bg_in, bg_out;
-  const Eigen::Vector3d bg_dir(0.2, -0.1, 1.0);
-  const double W = m.intrinsics().width;
-  for (size_t i = 0; i < seq.frames().size(); ++i) {
-    const auto& fr = seq.frames()[i];
-    // Feed gyro up to the last row (as the node does).
-    while (g < seq.gyro().size() &&
-           seq.gyro()[g].stamp <= seq.timing().LastRowTime(fr.stamp)) {
-      tl.AddSample(seq.gyro()[g++]);
-    }
-    if (g < seq.gyro().size()) tl.AddSample(seq.gyro()[g++]);
-    StabilizerFrame out;
-    if (reach_limit > 0.0) stab->SetReachLimit(reach_limit);
-    const Status s = stab->Process(fr.stamp, tl, seq.timing(), &fr.observed, &out);
-    EXPECT_TRUE(s.ok()) << s.message();
-    // Output head: the true landmarks through the solved pose, each with its
-    // row's real rotation.
-    Eigen::Vector2d h = Eigen::Vector2d::Zero();
-    for (size_t k = 0; k < fr.true_landmarks.size(); ++k) {
-      Eigen::Vector2d p;
-      EXPECT_TRUE(m.Project(fr.true_landmarks[k], out.R_v, out.t,
-                            out.rows.At(fr.true_rows[k]), &p));
-      h += p;
-    }
-    h /= fr.true_landmarks.size();
-    head_in.push_back(fr.true_centre * W);
-    head_out.push_back(h * W);
-    Eigen::Vector2d b, bo;
-    double row;
-    EXPECT_TRUE(seq.BackgroundPoint(static_cast<int>(i), bg_dir, &b, &row));
-    EXPECT_TRUE(m.Project(b, out.R_v, out.t, out.rows.At(row), &bo));
-    bg_in.push_back(b * W);
-    bg_out.push_back(bo * W);
-    EXPECT_TRUE(out.R_v.coeffs().allFinite());
-    EXPECT_TRUE(out.t.allFinite());
-    rr.frames_out.push_back(out);
-  }
-  const int win = 61;  // ~0.5 Hz at 30 fps
-  rr.input = {HighPassRms(head_in, win), HighPassRms(bg_in, win)};
-  rr.output = {HighPassRms(head_out, win), HighPassRms(bg_out, win)};
-  rr.undefined = static_cast<int>(stab->stats().undefined_frames);
-  rr.fallbacks = static_cast<int>(stab->stats().previous_warp_fallbacks);
-  rr.frames = static_cast<int>(stab->stats().frames);
-  return rr;
-}
-
-sim::LandmarkSequenceOptions Walk() {
-  sim::LandmarkSequenceOptions o;
-  o.duration_s = 6.0;
-  o.camera.shake_rms_rad = 0.012;
-  o.camera.translation_rms_m = 0.002;
-  o.shutter.readout_time_s = 0.02;
-  o.landmark_noise_px = 0.7;
-  o.gyro_noise = 0.003;
-  return o;
-}
-
-// Walking with violent shake (0.03 rad RMS), 3 s: more than RunSequence's
-// 10 % crop can hold.
-sim::LandmarkSequenceOptions ViolentShake() {
-  sim::LandmarkSequenceOptions o = Walk();
-  o.camera.shake_rms_rad = 0.03;
-  o.duration_s = 3.0;
-  return o;
-}
-
-void Print(const char* name, const RunResult& r) {
-  std::cout << "[ " << name << " ] head jitter in " << r.input.head_px
-            << " px -> " << r.output.head_px << " px; background "
-            << r.input.background_px << " -> " << r.output.background_px
-            << " px; undefined frames " << r.undefined << "/" << r.frames
-            << "\n";
-}
 
 TEST(StabilizerTest, BeatsGyroOnlyOnHeadJitterWalking) {
   const CameraModel m = Model640x360();
@@ -508,105 +406,6 @@ TEST(StabilizerTest, RejectsBadOptionsAndStamps) {
   EXPECT_FALSE(f.has_target);
   EXPECT_TRUE(f.R_v.coeffs().allFinite());
   EXPECT_TRUE(f.R_v.coeffs().allFinite());
-}
-
-// Paper Figs. 4-6 as measurements: each term's ablation.
-double MeanVirtualRealAngle(const RunResult& r) {
-  double s = 0.0;
-  for (const auto& f : r.frames_out) s += AngleBetween(f.R_v, f.R_r);
-  return s / r.frames_out.size();
-}
-
-double Roughness(const RunResult& r, bool rotation) {
-  double s2 = 0.0;
-  int n = 0;
-  for (size_t i = 2; i < r.frames_out.size(); ++i) {
-    const auto& a = r.frames_out[i - 2];
-    const auto& b = r.frames_out[i - 1];
-    const auto& c = r.frames_out[i];
-    const double d = rotation
-                         ? AngleBetween(c.R_v * b.R_v.conjugate(), b.R_v * a.R_v.conjugate())
-                         : (c.t - 2.0 * b.t + a.t).norm();
-    s2 += d * d;
-    ++n;
-  }
-  return std::sqrt(s2 / n);
-}
-
-TEST(StabilizerAblationTest, FollowingAndDistortionTermsHoldThePoseDuringAPan) {
-  // Paper Fig. 5: virtual camera deviation with/without E_o and E_d. Each
-  // term alone is compared with neither; E_p is off so that drift shows up
-  // as post-solve protrusion searches (the paper's fallback).
-  const CameraModel m = Model640x360();
-  sim::LandmarkSequenceOptions o = Walk();
-  o.camera.pan_rate = 0.25;  // rad/s, ramped in over 2 s
-  o.duration_s = 6.0;
-  const sim::LandmarkSequence seq(m, o);
-  StabilizerOptions so;
-  so.gyro_only = true;  // isolate the rotation terms
-  so.weights.distortion = 0.0;
-  so.weights.protrusion = 0.0;  // leave only the post-solve binary search
-  // E_d's default threshold (0.15 rad) is about what the 15 % crop admits,
-  // so on this pan the crop binds first; a threshold inside the crop's
-  // reach shows what the term does.
-  so.terms.distortion_threshold_rad = 0.05;
-  const RunResult follow_only = RunSequence(m, seq, so);
-  so.weights.follow = 0.0;
-  const RunResult neither = RunSequence(m, seq, so);
-  so.weights.distortion = StabilizerOptions().weights.distortion;
-  const RunResult distortion_only = RunSequence(m, seq, so);
-  auto searches = [](const RunResult& r) {
-    int n = 0;
-    for (const auto& f : r.frames_out) n += f.flags.protrusion_search;
-    return n;
-  };
-  std::cout << "[ ablation E_o/E_d, pan ] mean virtual-real angle: E_o only "
-            << MeanVirtualRealAngle(follow_only) << ", E_d only "
-            << MeanVirtualRealAngle(distortion_only) << ", neither "
-            << MeanVirtualRealAngle(neither) << " rad; protrusion searches "
-            << searches(follow_only) << " / " << searches(distortion_only) << " / "
-            << searches(neither) << "\n";
-  // At the default weights E_o is the weak one (it mostly trims the drift
-  // and the fallbacks); E_d holds the pose near the real one.
-  EXPECT_LT(MeanVirtualRealAngle(follow_only), MeanVirtualRealAngle(neither));
-  EXPECT_LT(MeanVirtualRealAngle(distortion_only), 0.6 * MeanVirtualRealAngle(neither));
-  EXPECT_GT(searches(neither), searches(follow_only));
-  EXPECT_GT(searches(neither), searches(distortion_only));
-  EXPECT_EQ(follow_only.undefined + distortion_only.undefined + neither.undefined, 0);
-}
-
-TEST(StabilizerAblationTest, WithoutSmoothnessThePoseIsRougher) {
-  const CameraModel m = Model640x360();
-  const sim::LandmarkSequence seq(m, Walk());
-  StabilizerOptions so;
-  const RunResult with = RunSequence(m, seq, so);
-  so.weights.rotation_c0 = so.weights.rotation_c1 = 0.0;
-  so.weights.translation_c0 = 1e-6;
-  so.weights.translation_c1 = 0.0;
-  const RunResult without = RunSequence(m, seq, so);
-  const double rot_w = Roughness(with, true), rot_wo = Roughness(without, true);
-  const double t_w = Roughness(with, false), t_wo = Roughness(without, false);
-  std::cout << "[ ablation E_r/E_t ] rotation roughness " << rot_w << " vs " << rot_wo
-            << " rad; offset roughness " << t_w << " vs " << t_wo << "\n";
-  EXPECT_GT(rot_wo, 1.3 * rot_w);
-  EXPECT_GT(t_wo, 1.3 * t_w);
-}
-
-TEST(StabilizerAblationTest, PaperLiteralHeadSmoothingAlsoBeatsGyroOnly) {
-  const CameraModel m = Model640x360();
-  const sim::LandmarkSequence seq(m, Walk());
-  StabilizerOptions so;
-  so.smooth_head_in_virtual_view = false;
-  const RunResult literal = RunSequence(m, seq, so);
-  so.smooth_head_in_virtual_view = true;
-  const RunResult ours = RunSequence(m, seq, so);
-  so.gyro_only = true;
-  const RunResult gyro = RunSequence(m, seq, so);
-  std::cout << "[ head smoothing domain ] head jitter: paper-literal " << literal.output.head_px
-            << " px, virtual-view " << ours.output.head_px << " px, gyro-only "
-            << gyro.output.head_px << " px\n";
-  EXPECT_LT(literal.output.head_px, 0.7 * gyro.output.head_px);
-  EXPECT_LT(ours.output.head_px, 0.6 * literal.output.head_px);
 }
 
 }  // namespace
