@@ -184,6 +184,33 @@ int Usage() {
 
 }  // namespace
 
+// One preset's composite figures: a markdown row and a CSV row.
+std::pair<std::string, std::string> CompositeRow(const std::string& preset,
+                                                 const steadiface::eval::CompositeQualityScore& q) {
+  auto f = [](double v, const char* fmt) {
+    if (!std::isfinite(v)) return std::string("nan");
+    char b[64];
+    std::snprintf(b, sizeof(b), fmt, v);
+    return std::string(b);
+  };
+  std::ostringstream md, csv;
+  md << "| " << preset << " | " << q.frames << " | " << f(q.matte_iou_mean, "%.3f") << " | "
+     << f(q.matte_iou_min, "%.3f") << " (" << q.matte_iou_min_frame << ") | "
+     << f(q.plate_mae, "%.2f") << " (" << f(q.ideal_plate_mae, "%.2f") << ") | "
+     << f(q.plate_pixels, "%.0f") << " | "
+     << f(q.fallback_share, "%.3f") << " | " << f(q.matte_change, "%.4f") << " | "
+     << f(q.truth_change, "%.4f") << " | " << f(q.edge_error_px, "%.2f") << " | "
+     << f(q.edge_max_step_px, "%.2f") << " |\n";
+  csv << preset << "," << q.frames << "," << f(q.matte_iou_mean, "%.4f") << ","
+      << f(q.matte_iou_min, "%.4f") << "," << q.matte_iou_min_frame << ","
+      << f(q.plate_mae, "%.3f") << "," << f(q.ideal_plate_mae, "%.3f") << ","
+      << f(q.plate_pixels, "%.0f") << ","
+      << f(q.fallback_share, "%.4f") << "," << f(q.matte_change, "%.5f") << ","
+      << f(q.truth_change, "%.5f") << "," << f(q.edge_error_px, "%.3f") << ","
+      << f(q.edge_max_step_px, "%.3f") << "\n";
+  return {md.str(), csv.str()};
+}
+
 int main(int argc, char** argv) {
   std::string data, out_dir;
   std::vector<std::string> presets = steadiface::sim::PresetNames();
@@ -208,6 +235,7 @@ int main(int argc, char** argv) {
   bool feasible_set = false;     // --feasible-set: write feasible_<preset>_<method>.csv
   double feasible_roll = 0.0;    // --feasible-roll MAX [rad]; 0: none
   bool reach_tube = false;       // --reach-tube: write reach_<preset>_<method>.csv
+  bool composite_frames = false;  // --composite-frames: composite_<preset>_<frame>.png
   steadiface::CommandLine cl;
   cl.String("--data", &data).String("--out", &out_dir);
   cl.Value("--presets", "a comma-separated list",
@@ -226,6 +254,17 @@ int main(int argc, char** argv) {
   cl.Double("--outline-margin", &blend.outline_margin_cells);
   cl.Double("--face-core", &blend.face_core_cells).Flag("--reach-tube", &reach_tube);
   cl.Double("--max-offset", &blend.max_offset);
+  cl.Flag("--composite-frames", &composite_frames);
+  steadiface::CompositeOptions composite;  // warp mode composite
+  cl.Double("--matte-softness", &composite.matte.prior_softness);
+  cl.Double("--matte-colour", &composite.matte.colour_weight);
+  cl.Double("--matte-temporal", &composite.matte.temporal);
+  cl.Double("--matte-plate-level", &composite.matte.plate_level);
+  cl.Double("--matte-motion-level", &composite.matte.motion_level);
+  cl.Double("--matte-search", &composite.matte.search_jaw_widths);
+  cl.Double("--matte-motion-memory", &composite.matte.motion_memory);
+  cl.Double("--plate-max-age", &composite.plate.max_age_s);
+  cl.Int("--plate-distance", &composite.plate_distance_px);
   cl.ClearFlag("--yield-to-background", &blend.yield_to_subject);
   cl.Double("--offset-lowpass", &blend.offset_lowpass_hz);
   cl.Value("--size", "WxH", [&](const std::string& v) {
@@ -258,6 +297,7 @@ int main(int argc, char** argv) {
   for (const std::string& name : methods) {
     if (name != "none" && name != "gyro-only" && name != "steadiface" &&
         name != "steadiface-layered" && name != "steadiface-layered/video" && name != "none/video" &&
+        name != "steadiface-composite" && name != "steadiface-composite/video" &&
         name != "steadiface/video" && name != "gyro-only/video" && name != "ffmpeg-vidstab" &&
         name != "ffmpeg-deshake") {
       std::cerr << "unknown method " << name << "\n";
@@ -287,6 +327,7 @@ int main(int argc, char** argv) {
                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   bool first = true;
   int failures = 0;
+  std::vector<std::pair<std::string, std::string>> composite_rows;  // table, csv
   auto fmt = [](const char* f, double v) {
     if (!std::isfinite(v)) return std::string("–");
     char b[64];
@@ -377,6 +418,7 @@ int main(int argc, char** argv) {
         const Method m = base == "none"                 ? Method::kNone
                          : base == "gyro-only"          ? Method::kGyroOnly
                          : base == "steadiface-layered" ? Method::kSteadifaceLayered
+                         : base == "steadiface-composite" ? Method::kSteadifaceComposite
                                                         : Method::kSteadiface;
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
@@ -387,18 +429,25 @@ int main(int argc, char** argv) {
         if (std::isfinite(reach_lowpass)) po.stabilizer.subject_reach_lowpass_hz = reach_lowpass;
         if (std::isfinite(reach_hold)) po.stabilizer.subject_reach_hold = reach_hold;
         po.warp.layered.blend = blend;
+        po.composite = composite;
         po.imu.imu_time_offset_s += offset_error;
         po.shutter.readout_time_s = std::max(0.0, po.shutter.readout_time_s + readout_error);
         std::unique_ptr<steadiface::eval::Scorecard> card;
         s = steadiface::eval::MakeScorecard(*sim, po, &card);
         steadiface::eval::VideoScorer* vsp = vs.get();
         std::vector<steadiface::StabilizerFrame> stab_frames;
+        steadiface::eval::CompositeQualityScore cq;
         if (s.ok()) {
           s = steadiface::eval::RunMethod(
               *sim, m, po, render || video, card.get(), &stab_frames,
               video ? std::function<steadiface::Status(const cv::Mat&)>(
                           [vsp](const cv::Mat& f) { return vsp->Add(f); })
-                    : nullptr);
+                    : nullptr,
+              m == Method::kSteadifaceComposite && !video ? &cq : nullptr,
+              composite_frames ? out_dir + "/composite_" + preset : std::string());
+        }
+        if (s.ok() && m == Method::kSteadifaceComposite && !video) {
+          composite_rows.push_back(CompositeRow(preset, cq));
         }
         if (s.ok() && !video) {
           sc = card->Compute();
@@ -518,5 +567,18 @@ int main(int argc, char** argv) {
     }
   }
   json << "\n  ]\n}\n";
+  if (!composite_rows.empty()) {
+    std::ofstream csv(out_dir + "/composite_quality.csv");
+    std::cout << "\n| preset | frames | matte IoU mean | matte IoU min (frame) | plate MAE grey |"
+                 " plate px | fallback share | matte change | truth change | edge error px |"
+                 " edge max step px |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    csv << "preset,frames,matte_iou_mean,matte_iou_min,matte_iou_min_frame,plate_mae,"
+           "ideal_plate_mae,plate_px,"
+           "fallback_share,matte_change,truth_change,edge_error_px,edge_max_step_px\n";
+    for (const auto& r : composite_rows) {
+      std::cout << r.first;
+      csv << r.second;
+    }
+  }
   return failures == 0 ? 0 : 1;
 }

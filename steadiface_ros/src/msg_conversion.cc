@@ -433,7 +433,18 @@ void FillLayers(const steadiface::PipelineFrame& pf, steadiface::StabilizerState
   m.has_background_layer = f.background.valid;
   m.background_rotation = ToMsg(f.background.R_v);
   m.background_principal_offset = {f.background.t.x(), f.background.t.y()};
-  m.warp_mode = pf.layered.active ? "layered" : "global";
+  m.warp_mode = pf.layered.active ? "layered" : pf.composite.active ? "composite" : "global";
+  if (pf.composite.active) {
+    const steadiface::CompositeReport& c = pf.composite.report;
+    m.layer_blend = pf.composite.region.blend;
+    m.layer_blend_step = pf.composite.region.blend_step;
+    m.matte_mean = c.matte_mean;
+    m.uncovered_px = c.uncovered_px;
+    m.plate_share = c.plate_share;
+    m.fallback_share = c.fallback_share;
+    m.plate_coverage = c.plate_coverage;
+    m.plate_restarts = static_cast<uint32_t>(std::max(0, c.plate_restarts));
+  }
   if (pf.layered.active) {
     const steadiface::LayerBlendReport& b = pf.layered.blend;
     m.layer_blend = pf.layered.region.blend;
@@ -477,7 +488,8 @@ void ZeroNonFinite(steadiface::StabilizerState* out) {
                     &m.face_appearance, &m.imu_offset_applied_s,
                     &m.layer_blend, &m.layer_blend_step, &m.band_px, &m.layer_offset_px,
                     &m.layer_offset_capped_px, &m.layer_shift_px, &m.layer_keep,
-                    &m.min_cell_ratio}) {
+                    &m.min_cell_ratio, &m.matte_mean, &m.uncovered_px, &m.plate_share,
+                    &m.fallback_share, &m.plate_coverage}) {
     clean(*v);
   }
 }

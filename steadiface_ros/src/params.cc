@@ -408,6 +408,26 @@ void ReadLayered(Reader& r, steadiface::LayeredWarpOptions* lw) {
   r.Num("warp/layered/ramp", &lw->region.ramp_s);
 }
 
+void ReadComposite(Reader& r, steadiface::CompositeOptions* c) {
+  r.Num("composite/plate_below", &c->plate_below);
+  r.Int("composite/plate_distance", &c->plate_distance_px);
+  r.Int("composite/matte/scale", &c->matte.scale);
+  r.Num("composite/matte/search", &c->matte.search_jaw_widths);
+  r.Num("composite/matte/prior_softness", &c->matte.prior_softness);
+  r.Num("composite/matte/plate_level", &c->matte.plate_level);
+  r.Num("composite/matte/motion_level", &c->matte.motion_level);
+  r.Num("composite/matte/motion_memory", &c->matte.motion_memory);
+  r.Num("composite/matte/colour_weight", &c->matte.colour_weight);
+  r.Num("composite/matte/temporal", &c->matte.temporal);
+  r.Int("composite/matte/edge_radius", &c->matte.edge_radius_px);
+  r.Num("composite/matte/edge_eps", &c->matte.edge_eps);
+  r.Num("composite/plate/margin", &c->plate.margin);
+  r.Num("composite/plate/max_age", &c->plate.max_age_s);
+  r.Num("composite/plate/update_rate", &c->plate.update_rate);
+  r.Num("composite/plate/reset_angle", &c->plate.reset_angle_deg);
+  r.Num("composite/plate/scene_cut_level", &c->plate.scene_cut_level);
+}
+
 void ReadGyroVideoCheck(Reader& r, steadiface::GyroVideoCheckOptions* c) {
   r.Bool("gyro_video_check/enabled", &c->enabled);
   r.Int("gyro_video_check/stride", &c->stride);
@@ -441,6 +461,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   ReadSolverAndStabilizer(r, &po->stabilizer);
   ReadOutputAndWarp(r, &po->warp);
   ReadLayered(r, &po->warp.layered);
+  ReadComposite(r, &po->composite);
   ReadGyroVideoCheck(r, &po->gyro_video_check);
   const Status st = r.status();
   if (!st.ok()) return st;

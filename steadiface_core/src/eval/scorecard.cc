@@ -1,5 +1,7 @@
 #include "steadiface_core/eval/scorecard.h"
 
+#include "steadiface_core/composite/layer_homography.h"
+
 #include "steadiface_core/common/high_pass_rms.h"
 #include "steadiface_core/common/percentile.h"
 
@@ -203,9 +205,12 @@ bool Scorecard::MapToOutput(const FrameWarp& w, const Eigen::Vector2d& p,
     }
     case FrameWarp::Kind::kMesh:
       return InvertMesh(w, p, out);
+    case FrameWarp::Kind::kComposite:  // the far scene: the background layer
     case FrameWarp::Kind::kPose: {
+      const bool bg = w.kind == FrameWarp::Kind::kComposite;
       Eigen::Vector2d V;
-      if (!model_.Project(model_.PixelToNormalized(p), w.R_v, w.t, w.rows.At(p.y()), &V)) {
+      if (!model_.Project(model_.PixelToNormalized(p), bg ? w.R_b : w.R_v, bg ? w.t_b : w.t,
+                          w.rows.At(p.y()), &V)) {
         return false;
       }
       *out = output_.VirtualToOutputPixel(V);
@@ -215,12 +220,24 @@ bool Scorecard::MapToOutput(const FrameWarp& w, const Eigen::Vector2d& p,
   return false;
 }
 
+bool Scorecard::CompositeCovers(int index, const FrameWarp& w, const Eigen::Vector2d& o) const {
+  // The direction the subject layer shows at o, and where it is in the input.
+  const LayerView v = OutputView(output_, w.R_v, w.t);
+  const Eigen::Vector3d d = v.R.conjugate() * (v.K.inverse() * o.homogeneous());
+  Eigen::Vector2d px;
+  const CameraIntrinsics& ki = sim_.intrinsics();
+  return sim_.BackgroundPixel(index, d.normalized(), &px) && px.x() >= 0 && px.y() >= 0 &&
+         px.x() <= ki.width - 1 && px.y() <= ki.height - 1 && sim_.SubjectCovers(index, px);
+}
+
 void Scorecard::Add(int index, const FrameWarp& w) {
   const sim::SimTruth truth = sim_.Truth(index);
   Sample s;
   s.t = ToSeconds(truth.stamp);
   s.head_in = truth.head_px;
-  s.head_valid = truth.head_in_view && MapToOutput(w, truth.head_px, &s.head_out);
+  FrameWarp subject = w;  // the head: the subject layer's pose
+  if (w.kind == FrameWarp::Kind::kComposite) subject.kind = FrameWarp::Kind::kPose;
+  s.head_valid = truth.head_in_view && MapToOutput(subject, truth.head_px, &s.head_out);
   if (!s.head_valid) s.head_out = Eigen::Vector2d::Constant(NAN);
   head_out_.push_back(s.head_out);
   head_valid_.push_back(s.head_valid);
@@ -254,9 +271,11 @@ void Scorecard::AddVisibleBackground(int index, const FrameWarp& w) {
   auto visible_out = [&](const Eigen::Vector3d& d, Eigen::Vector2d* o) {
     Eigen::Vector2d px;
     return sim_.BackgroundPixel(index, d, &px) && px.x() >= 0 && px.y() >= 0 &&
-           px.x() <= ki.width - 1 && px.y() <= ki.height - 1 && !sim_.SubjectCovers(index, px) &&
+           px.x() <= ki.width - 1 && px.y() <= ki.height - 1 &&
+           (w.kind == FrameWarp::Kind::kComposite || !sim_.SubjectCovers(index, px)) &&
            MapToOutput(w, px, o) && o->x() >= 0 && o->y() >= 0 && o->x() <= ow - 1 &&
-           o->y() <= oh - 1;
+           o->y() <= oh - 1 &&
+           (w.kind != FrameWarp::Kind::kComposite || !CompositeCovers(index, w, *o));
   };
   for (size_t k = 0; k < visible_dirs_.size(); ++k) {
     Eigen::Vector2d o;
@@ -356,8 +375,11 @@ bool Scorecard::Undefined(const FrameWarp& w, Sample* s) const {
       }
     }
   }
-  if (w.kind == FrameWarp::Kind::kPose) {
+  if (w.kind == FrameWarp::Kind::kPose || w.kind == FrameWarp::Kind::kComposite) {
     undefined = !protrusion_.Check(w.R_v, w.t, w.rows, 0.0).defined;
+    if (w.kind == FrameWarp::Kind::kComposite) {
+      undefined = undefined || !protrusion_.Check(w.R_b, w.t_b, w.rows, 0.0).defined;
+    }
     const Eigen::Vector3d v = LogSO3(w.R_v), r = LogSO3(w.rows.Middle());
     for (int i = 0; i < 3; ++i) {
       s->virtual_angle[i] = v[i];

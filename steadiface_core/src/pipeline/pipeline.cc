@@ -31,6 +31,8 @@ Status ValidatePipelineOptions(const PipelineOptions& o) {
   if (!s.ok()) return s;
   s = ValidateGyroVideoCheckOptions(o.gyro_video_check);
   if (!s.ok()) return s;
+  s = ValidateCompositeOptions(o.composite);
+  if (!s.ok()) return s;
   return ValidateWarpOptions(o.warp);
 }
 
@@ -43,6 +45,10 @@ Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
 
 StabilizerOptions ForWarp(const StabilizerOptions& options, const WarpOptions& warp) {
   StabilizerOptions o = options;
+  // The composite needs the background layer's pose every frame; the
+  // subject layer is the global warp's (H is not held: the plate fills what
+  // the subject uncovers).
+  if (warp.mode == WarpMode::kComposite) o.background_layer = true;
   if (warp.mode != WarpMode::kLayered) return o;
   // The layered warp needs the background layer's pose every frame, and
   // holds H within what the band absorbs of where that layer shows the face
@@ -78,6 +84,10 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
   if (!s.ok()) return s;
   s = Warper::Create(model, options.warp, &p->warper_);
   if (!s.ok()) return s;
+  if (options.warp.mode == WarpMode::kComposite) {
+    s = Compositor::Create(p->warper_->output_geometry(), options.composite, &p->compositor_);
+    if (!s.ok()) return s;
+  }
   if (options.gyro_video_check.enabled) {
     s = GyroVideoCheck::Create(model.intrinsics(), p->timing_, options.imu.R_cam_imu.normalized(),
                                options.gyro_video_check, &p->check_);
@@ -126,8 +136,9 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   Status s = stabilizer_->Process(stamp, timeline_, timing_, obs, &f.stabilizer);
   f.timings.stabilizer_ms = MsSince(t_stab);
   if (!s.ok()) return s;
-  s = WarpStep(image, stamp, obs, &f);
-  if (s.ok() && defer_render_) {
+  s = options_.warp.mode == WarpMode::kComposite ? CompositeStep(image, stamp, obs, &f)
+                                                : WarpStep(image, stamp, obs, &f);
+  if (s.ok() && defer_render_ && options_.warp.mode != WarpMode::kComposite) {
     f.mesh = warper_->mesh();
     f.output_size = cv::Size(warper_->output_geometry().width(),
                              warper_->output_geometry().height());
@@ -223,6 +234,40 @@ Status Pipeline::WarpStep(const cv::Mat& image, Time stamp, const FaceObservatio
   return s;
 }
 
+Status Pipeline::CompositeStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
+                               PipelineFrame* out) {
+  PipelineFrame& f = *out;
+  const StabilizerFrame::LayerPose& b = f.stabilizer.background;
+  const Eigen::Quaterniond R_b = b.valid ? b.R_v : f.stabilizer.R_v;
+  const Eigen::Vector2d t_b = b.valid ? b.t : f.stabilizer.t;
+  const OutputGeometry& geometry = warper_->output_geometry();
+  f.output_intrinsics = geometry.VirtualIntrinsics(t_b);
+  // The subject region from this frame's face, in the background layer's
+  // view (where the matte is made).
+  const double dt = has_last_stamp_ ? ToSeconds(stamp) - ToSeconds(last_stamp_) : 0.0;
+  has_last_stamp_ = true;
+  last_stamp_ = stamp;
+  f.composite.active = true;
+  f.composite.region = region_->Update(model_, geometry, R_b, t_b, f.stabilizer.rows, obs,
+                                       f.stabilizer.factors.presence_target, dt);
+  if (!options_.render_output) return Status::Ok();
+  // Both layers' pictures, then their composite (into the background's).
+  Status s = warper_->Warp(image, f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows,
+                           &subject_picture_);
+  double mesh_ms = warper_->timings().mesh_ms, remap_ms = warper_->timings().remap_ms;
+  double maps_ms = warper_->timings().maps_ms;
+  if (s.ok()) s = warper_->Warp(image, R_b, t_b, f.stabilizer.rows, &f.output);
+  f.timings.mesh_ms = mesh_ms + warper_->timings().mesh_ms;
+  f.timings.maps_ms = maps_ms + warper_->timings().maps_ms;
+  f.timings.remap_ms = remap_ms + warper_->timings().remap_ms;
+  if (!s.ok()) return s;
+  s = compositor_->Compose(subject_picture_, OutputView(geometry, f.stabilizer.R_v, f.stabilizer.t),
+                           f.output, OutputView(geometry, R_b, t_b), f.composite.region,
+                           ToSeconds(stamp), &f.output);
+  f.composite.report = compositor_->report();
+  return s;
+}
+
 Status Pipeline::ProcessFrameDeferred(const cv::Mat& image, Time stamp,
                                       const std::vector<Eigen::Vector2d>* external,
                                       double external_confidence, PipelineFrame* out) {
@@ -295,7 +340,13 @@ Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered
     s = stabilizer_->UpdateOptions(next);
     if (!s.ok()) return s;
   }
+  std::unique_ptr<Compositor> compositor;
+  if (mode == WarpMode::kComposite) {
+    s = Compositor::Create(warper->output_geometry(), options_.composite, &compositor);
+    if (!s.ok()) return s;
+  }
   warper_ = std::move(warper);
+  compositor_ = std::move(compositor);
   options_.warp = w;
   region_.reset(new SubjectRegionTracker(layered.region));
   has_last_stamp_ = false;
@@ -309,6 +360,7 @@ void Pipeline::Reset() {
   if (check_ != nullptr) check_->Reset();
   region_->reset();
   warper_->reset();
+  if (compositor_ != nullptr) compositor_->Reset();
   has_last_stamp_ = false;
   // A new epoch starts from the configuration: a replayed bag (rosbag play
   // --loop) reproduces a fresh start exactly; the check finds the offset

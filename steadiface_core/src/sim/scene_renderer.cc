@@ -36,6 +36,69 @@ Billboard MakeFaceBillboard(const cv::Mat& photo, const cv::Rect& region,
   return b;
 }
 
+namespace {
+
+// One billboard's texture sampled at every image pixel (BGRA; alpha 0 off
+// the board), each band of rows with its own poses.
+void RenderBoard(const CameraIntrinsics& k, const std::function<double(double)>& row_time,
+                 const std::function<Pose(double)>& camera_pose, const Billboard* b, int band,
+                 cv::Mat* layer) {
+  const Eigen::Matrix3d K =
+      (Eigen::Matrix3d() << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1).finished();
+  cv::Mat map_x(k.height, k.width, CV_32FC1), map_y(k.height, k.width, CV_32FC1);
+  for (int y0 = 0; y0 < k.height; y0 += band) {
+    const int y1 = std::min(k.height, y0 + band);
+    const double t = row_time(0.5 * (y0 + y1 - 1));
+    const Pose C = camera_pose(t);
+    const Pose P = b->pose(t);
+    // texture (u, v, 1) -> image, through the plane.
+    const Eigen::Matrix3d Rcw = C.R.conjugate().toRotationMatrix();
+    const Eigen::Matrix3d Rh = P.R.toRotationMatrix();
+    const double s = b->metres_per_px;
+    Eigen::Matrix3d A;
+    A.col(0) = s * Rh.col(0);
+    A.col(1) = s * Rh.col(1);
+    A.col(2) = P.p - C.p - s * (Rh.col(0) * b->anchor_px.x() + Rh.col(1) * b->anchor_px.y());
+    const Eigen::Matrix3d H = K * Rcw * A;
+    const Eigen::Matrix3d G = H.inverse();
+    for (int y = y0; y < y1; ++y) {
+      float* mx = map_x.ptr<float>(y);
+      float* my = map_y.ptr<float>(y);
+      for (int x = 0; x < k.width; ++x) {
+        const Eigen::Vector3d uvw = G * Eigen::Vector3d(x, y, 1.0);
+        if (uvw.z() <= 1e-12) {  // behind the camera
+          mx[x] = my[x] = -1e4f;
+          continue;
+        }
+        mx[x] = static_cast<float>(uvw.x() / uvw.z());
+        my[x] = static_cast<float>(uvw.y() / uvw.z());
+      }
+    }
+  }
+  cv::remap(b->bgra, *layer, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar::all(0));
+}
+
+}  // namespace
+
+void RenderAlpha(const CameraIntrinsics& k, const std::function<double(double)>& row_time,
+                 const std::function<Pose(double)>& camera_pose,
+                 const std::vector<const Billboard*>& billboards, int band_rows, cv::Mat* out) {
+  *out = cv::Mat(k.height, k.width, CV_8UC1, cv::Scalar(0));
+  cv::Mat layer;
+  for (const Billboard* b : billboards) {
+    RenderBoard(k, row_time, camera_pose, b, std::max(1, band_rows), &layer);
+    for (int y = 0; y < k.height; ++y) {
+      const cv::Vec4b* src = layer.ptr<cv::Vec4b>(y);
+      uchar* dst = out->ptr<uchar>(y);
+      for (int x = 0; x < k.width; ++x) {
+        const int a = src[x][3];
+        dst[x] = static_cast<uchar>(a + (dst[x] * (255 - a) + 127) / 255);
+      }
+    }
+  }
+}
+
 void RenderScene(const CameraIntrinsics& k,
                  const std::function<double(double)>& row_time,
                  const std::function<Pose(double)>& camera_pose,
@@ -46,42 +109,9 @@ void RenderScene(const CameraIntrinsics& k,
   background.Render(k, [&](double y) {
     return camera_pose(row_time(y)).R.conjugate();  // world -> camera
   }, band, out);
-  const Eigen::Matrix3d K =
-      (Eigen::Matrix3d() << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1).finished();
-  cv::Mat map_x(k.height, k.width, CV_32FC1), map_y(k.height, k.width, CV_32FC1);
   cv::Mat layer;
   for (const Billboard* b : billboards) {
-    for (int y0 = 0; y0 < k.height; y0 += band) {
-      const int y1 = std::min(k.height, y0 + band);
-      const double t = row_time(0.5 * (y0 + y1 - 1));
-      const Pose C = camera_pose(t);
-      const Pose P = b->pose(t);
-      // texture (u, v, 1) -> image, through the plane.
-      const Eigen::Matrix3d Rcw = C.R.conjugate().toRotationMatrix();
-      const Eigen::Matrix3d Rh = P.R.toRotationMatrix();
-      const double s = b->metres_per_px;
-      Eigen::Matrix3d A;
-      A.col(0) = s * Rh.col(0);
-      A.col(1) = s * Rh.col(1);
-      A.col(2) = P.p - C.p - s * (Rh.col(0) * b->anchor_px.x() + Rh.col(1) * b->anchor_px.y());
-      const Eigen::Matrix3d H = K * Rcw * A;
-      const Eigen::Matrix3d G = H.inverse();
-      for (int y = y0; y < y1; ++y) {
-        float* mx = map_x.ptr<float>(y);
-        float* my = map_y.ptr<float>(y);
-        for (int x = 0; x < k.width; ++x) {
-          const Eigen::Vector3d uvw = G * Eigen::Vector3d(x, y, 1.0);
-          if (uvw.z() <= 1e-12) {  // behind the camera
-            mx[x] = my[x] = -1e4f;
-            continue;
-          }
-          mx[x] = static_cast<float>(uvw.x() / uvw.z());
-          my[x] = static_cast<float>(uvw.y() / uvw.z());
-        }
-      }
-    }
-    cv::remap(b->bgra, layer, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-              cv::Scalar::all(0));
+    RenderBoard(k, row_time, camera_pose, b, band, &layer);
     for (int y = 0; y < k.height; ++y) {
       const cv::Vec4b* src = layer.ptr<cv::Vec4b>(y);
       cv::Vec3b* dst = out->ptr<cv::Vec3b>(y);

@@ -28,22 +28,35 @@ Status ParseWarpMode(const std::string& name, WarpMode* mode) {
     *mode = WarpMode::kGlobal;
   } else if (name == "layered") {
     *mode = WarpMode::kLayered;
+  } else if (name == "composite") {
+    *mode = WarpMode::kComposite;
   } else {
-    return Status::Error("warp.mode must be 'global' or 'layered', got '" + name + "'");
+    return Status::Error("warp.mode must be 'global', 'layered' or 'composite', got '" + name +
+                         "'");
   }
   return Status::Ok();
 }
 
 const char* WarpModeName(WarpMode mode) {
-  return mode == WarpMode::kLayered ? "layered" : "global";
+  switch (mode) {
+    case WarpMode::kLayered:
+      return "layered";
+    case WarpMode::kComposite:
+      return "composite";
+    case WarpMode::kGlobal:
+      break;
+  }
+  return "global";
 }
 
 Status ValidateWarpOptions(const WarpOptions& o) {
   Status s = ValidateOutputOptions(o.output);
   if (!s.ok()) return s;
-  if (o.mode == WarpMode::kLayered) {
+  if (o.mode != WarpMode::kGlobal) {  // the subject region (layered and composite)
     s = ValidateSubjectRegionOptions(o.layered.region);
     if (!s.ok()) return s;
+  }
+  if (o.mode == WarpMode::kLayered) {
     s = ValidateLayerBlendOptions(o.layered.blend);
     if (!s.ok()) return s;
     if (o.layered.mesh_cols < 2 || o.layered.mesh_cols > 512 || o.layered.mesh_rows < 2 ||

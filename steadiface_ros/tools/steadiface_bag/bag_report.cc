@@ -19,11 +19,13 @@ namespace {
 using steadiface::HighPassRms;
 using steadiface::Percentile;
 
-// "gyro-only", "steadiface" or "steadiface-layered" (warp/mode layered).
+// "gyro-only", "steadiface", "steadiface-layered" or "steadiface-composite"
+// (warp/mode layered or composite).
 std::string MethodName(const ReportInputs& r, const BagSink& sink) {
   if (r.gyro_only) return "gyro-only";
-  const bool layered = !sink.states.empty() && sink.states.back().warp_mode == "layered";
-  return layered ? "steadiface-layered" : "steadiface";
+  const std::string mode = sink.states.empty() ? "global" : sink.states.back().warp_mode;
+  if (mode == "layered" || mode == "composite") return "steadiface-" + mode;
+  return "steadiface";
 }
 
 // The plot trajectories of one scorecard (scripts/plot_report.py).

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "steadiface_core/eval/composite_quality.h"
 #include "steadiface_core/eval/scorecard.h"
 #include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
@@ -17,7 +18,8 @@ enum class Method {
   kNone,        ///< input as is
   kGyroOnly,    ///< steadiface with w_f = 0 (no face)
   kSteadiface,  ///< the full method, dlib landmarks from the rendered frames
-  kSteadifaceLayered,  ///< the full method with the layered warp (issue 15)
+  kSteadifaceLayered,  ///< the full method with the layered warp
+  kSteadifaceComposite,  ///< the full method with the composite warp
 };
 const char* MethodName(Method m);
 
@@ -51,11 +53,17 @@ void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_off
 /// (render_output off unless `render`), and scores the warps. Fills
 /// `score` and `card` (for trajectories); `frames_out` (optional) receives
 /// the stabilizer frames; `on_output` (optional, needs `render`) receives
-/// each output image (for kNone: the input frame).
+/// each output image (for kNone: the input frame). The composite always
+/// renders (its matte and plate are made from the pictures) and, with
+/// `composite_quality`, is scored against the truth (CompositeQuality);
+/// `composite_frames`, a path prefix, also writes every 15th frame's
+/// picture (CompositeQuality::DumpFrames).
 Status RunMethod(const sim::Simulator& sim, Method method,
                  const PipelineOptions& options, bool render,
                  Scorecard* card, std::vector<StabilizerFrame>* frames_out,
-                 const std::function<Status(const cv::Mat&)>& on_output = nullptr);
+                 const std::function<Status(const cv::Mat&)>& on_output = nullptr,
+                 CompositeQualityScore* composite_quality = nullptr,
+                 const std::string& composite_frames = std::string());
 
 }  // namespace eval
 }  // namespace steadiface

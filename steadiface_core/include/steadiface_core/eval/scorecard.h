@@ -23,11 +23,20 @@ struct FrameWarp {
     kPose,        ///< steadiface: virtual pose + per-row real rotation
     kHomography,  ///< any per-frame homography (input px -> output px)
     kMesh,        ///< a warp mesh (output vertices -> input px), e.g. layered
+    /// The composite: the subject through (R_v, t), the far scene through the
+    /// background layer's (R_b, t_b), hidden where the subject, placed by
+    /// (R_v, t), covers it in the output. Scored as if matte and plate were
+    /// exact; their errors against the truth are the composite's own
+    /// figures (CompositeQuality).
+    kComposite,
   };
   Kind kind = Kind::kIdentity;
   Eigen::Quaterniond R_v = Eigen::Quaterniond::Identity();
   Eigen::Vector2d t = Eigen::Vector2d::Zero();
   RowRotations rows;
+  /// kComposite: the background layer's pose.
+  Eigen::Quaterniond R_b = Eigen::Quaterniond::Identity();
+  Eigen::Vector2d t_b = Eigen::Vector2d::Zero();
   Eigen::Matrix3d H = Eigen::Matrix3d::Identity();
   /// kMesh: vertex columns / rows at output px u, v; the source (input px)
   /// of vertex (i, j) at [j * u.size() + i]; optionally the background
@@ -169,6 +178,9 @@ class Scorecard {
   void ComputeMeshFigures(double fps, Score* sc) const;
   bool MapToOutput(const FrameWarp& w, const Eigen::Vector2d& in_px,
                    Eigen::Vector2d* out_px) const;
+  // kComposite: whether the subject, placed by the subject layer, covers
+  // output pixel `out_px` of frame `index`.
+  bool CompositeCovers(int index, const FrameWarp& w, const Eigen::Vector2d& out_px) const;
 
   const sim::Simulator& sim_;
   const CameraModel model_;

@@ -10,6 +10,7 @@
 #include "steadiface_core/camera/rolling_shutter.h"
 #include "steadiface_core/check/gyro_video_check.h"
 #include "steadiface_core/common/status.h"
+#include "steadiface_core/composite/compositor.h"
 #include "steadiface_core/face/face_tracker.h"
 #include "steadiface_core/gyro/orientation_timeline.h"
 #include "steadiface_core/stabilizer/stabilizer.h"
@@ -40,6 +41,8 @@ struct PipelineOptions {
   FaceTrackerOptions face;
   StabilizerOptions stabilizer;
   WarpOptions warp;
+  /// The composite (warp mode composite): matte, plate, blend.
+  CompositeOptions composite;
   /// Produce the stabilized image (false: poses only, e.g. for scoring).
   bool render_output = true;
   /// The live check of the gyro's configuration against the video.
@@ -73,6 +76,15 @@ struct LayeredFrame {
   LayerBlendReport blend;
 };
 
+/// The composite's view of one frame (warp mode composite).
+struct CompositeFrame {
+  bool active = false;  ///< warp mode is composite
+  /// The subject region in the background layer's view (output px).
+  SubjectRegion region;
+  /// What the compositor did (zero when the output was not rendered).
+  CompositeReport report;
+};
+
 /// One processed frame.
 struct PipelineFrame {
   FaceInfo face;
@@ -90,6 +102,8 @@ struct PipelineFrame {
   double imu_offset_applied_s = 0.0;
   /// The layered warp (warp mode layered).
   LayeredFrame layered;
+  /// The composite (warp mode composite).
+  CompositeFrame composite;
   /// ProcessFrameDeferred: the frame's warp mesh and output size, for
   /// RenderDeferred (empty otherwise).
   WarpMesh mesh;
@@ -124,7 +138,9 @@ class Pipeline {
                       double external_confidence, PipelineFrame* out);
 
   /// ProcessFrame without the rendering: `out->mesh` and `out->output_size`
-  /// describe the warp, `out->output` stays empty. RenderDeferred renders it
+  /// describe the warp, `out->output` stays empty. (Warp mode composite
+  /// renders at once: its plate is the stream's state; the mesh stays
+  /// empty and RenderDeferred keeps the output.) RenderDeferred renders it
   /// later, on any thread, while this pipeline goes on with the next frame
   /// (a two-stage pipeline; the rendering is SampleMesh, bit-for-bit
   /// ProcessFrame's with direct sampling or fixed-point maps).
@@ -155,6 +171,8 @@ class Pipeline {
   const OrientationTimeline& timeline() const { return timeline_; }
   const Stabilizer& stabilizer() const { return *stabilizer_; }
   const Warper& warper() const { return *warper_; }
+  /// The compositor (warp mode composite; else null).
+  const Compositor* compositor() const { return compositor_.get(); }
   const CameraModel& camera_model() const { return model_; }
   const RowTiming& row_timing() const { return timing_; }
   const PipelineOptions& options() const { return options_; }
@@ -170,6 +188,9 @@ class Pipeline {
                                   FaceObservation* observation, PipelineFrame* f);
   Status WarpStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
                   PipelineFrame* f);
+  // WarpStep in composite mode: both layers' pictures and their composite.
+  Status CompositeStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
+                       PipelineFrame* f);
   Pipeline(const CameraModel& model, const PipelineOptions& options);
   void ApplyOffsetEstimate(Time stamp);
 
@@ -181,7 +202,9 @@ class Pipeline {
   std::unique_ptr<Stabilizer> stabilizer_;
   std::unique_ptr<Warper> warper_;
   std::unique_ptr<GyroVideoCheck> check_;  // null when disabled
-  std::unique_ptr<SubjectRegionTracker> region_;  // layered mode
+  std::unique_ptr<SubjectRegionTracker> region_;  // layered and composite mode
+  std::unique_ptr<Compositor> compositor_;       // composite mode
+  cv::Mat subject_picture_;                      // composite: the subject layer's
   bool has_last_stamp_ = false;
   Time last_stamp_;
   // gyro_video_check/apply_offset: the previous frame's stamp (rate limit).

@@ -50,6 +50,12 @@ void RenderScene(const CameraIntrinsics& k,
                  const std::vector<const Billboard*>& billboards, int band_rows,
                  cv::Mat* out_bgr);
 
+/// The coverage (alpha, CV_8UC1) of `billboards` alone, composited as
+/// RenderScene composites them: the true matte of what they show.
+void RenderAlpha(const CameraIntrinsics& k, const std::function<double(double)>& row_time,
+                 const std::function<Pose(double)>& camera_pose,
+                 const std::vector<const Billboard*>& billboards, int band_rows, cv::Mat* out);
+
 /// Projects a world point into the camera at its own row (rolling-shutter
 /// fixed point). Returns false behind the camera.
 bool ProjectRollingShutter(const CameraIntrinsics& k,

@@ -100,7 +100,10 @@ struct SimulatorOptions {
 /// (a walking selfie at arm's length, 0.7 m, with head and shoulders in
 /// front of a building: what the layered warp is judged on), shake (the
 /// recorded running trace at 3x, grey, 25 ms exposure blur, 30 ms
-/// readout: what the face tracker is judged on under strong shake).
+/// readout: what the face tracker is judged on under strong shake), drift,
+/// walk_across, bob (a walking selfie whose head bobs against the scene by
+/// +-100 px at 720p, with neck and shoulders: what the composite is judged
+/// on).
 Status ApplyPreset(const std::string& name, SimulatorOptions* options);
 const std::vector<std::string>& PresetNames();
 
@@ -143,6 +146,10 @@ class Simulator {
   Status Render(int i, cv::Mat* bgr, SimTruth* truth) const;
   /// Truth only (fast).
   SimTruth Truth(int i) const;
+  /// The truth behind the composite: frame i as Render makes it without the
+  /// subject (face and torso; the scene, passers-by and the hand stay), and
+  /// the subject's true coverage (CV_8UC1, 255 = the subject alone).
+  Status RenderTruthLayers(int i, cv::Mat* scene, cv::Mat* subject_alpha) const;
 
   /// True camera-to-world pose at time t [s].
   Pose CameraPose(double t) const;
@@ -163,6 +170,9 @@ class Simulator {
   void MakeSecondFaceAndOccluder(const cv::Mat& photo, double m_per_px);
   Status LoadRealGyro();
   void SynthesizeImu();
+  // Frame i, with or without the subject.
+  void RenderFrame(int i, bool with_subject, cv::Mat* bgr) const;
+  std::vector<const Billboard*> SubjectBoards() const;
   Eigen::Vector3d Body(double t) const;
   /// Applies the pan orbit (if any) to a world pose.
   Pose Orbit(const Pose& P, double t) const;

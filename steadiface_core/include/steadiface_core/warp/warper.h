@@ -28,9 +28,14 @@ enum class WarpMode {
   /// gyro-only pose), joined across a band by a per-frame mesh
   /// optimization (LayerBlend).
   kLayered,
+  /// Two layers composited (Compositor): the subject, cut out by a matte,
+  /// warped by the face-following layer's pose, over the background layer
+  /// (the gyro-only pose); what the subject uncovers comes from a plate of
+  /// the scene built from recent frames.
+  kComposite,
 };
 
-/// Parses "global" / "layered".
+/// Parses "global" / "layered" / "composite".
 Status ParseWarpMode(const std::string& name, WarpMode* mode);
 const char* WarpModeName(WarpMode mode);
 
@@ -50,7 +55,7 @@ struct LayeredWarpOptions {
 struct WarpOptions {
   /// Global (one virtual camera) or layered (subject + background).
   WarpMode mode = WarpMode::kGlobal;
-  /// Used in layered mode.
+  /// Used in layered mode; its subject region also in composite mode.
   LayeredWarpOptions layered;
   /// Output crop and size.
   OutputOptions output;

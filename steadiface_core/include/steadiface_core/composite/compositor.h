@@ -1,0 +1,113 @@
+#pragma once
+
+#include <memory>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/composite/background_plate.h"
+#include "steadiface_core/composite/layer_homography.h"
+#include "steadiface_core/composite/subject_matte.h"
+#include "steadiface_core/layered/subject_region.h"
+#include "steadiface_core/warp/output_geometry.h"
+
+namespace steadiface {
+
+/// Options of the composite warp (warp mode composite).
+struct CompositeOptions {
+  /// The subject's matte.
+  SubjectMatteOptions matte;
+  /// The background plate.
+  BackgroundPlateOptions plate;
+  /// The plate takes pixels whose matte is below this [0-1] ...
+  double plate_below = 0.1;
+  /// ... within this distance (a subject's soft edge, hair, is a mix of
+  /// subject and scene) [output px].
+  int plate_distance_px = 3;
+};
+
+Status ValidateCompositeOptions(const CompositeOptions& options);
+
+/// What the composite did to one frame.
+struct CompositeReport {
+  bool active = false;  ///< a subject was composited (else: the background layer)
+  /// The output rectangles the matte covered, in the background layer's and
+  /// in the subject layer's view [output px].
+  cv::Rect background_roi, subject_roi;
+  /// Pixels the subject uncovered (the background layer shows the subject
+  /// there, the composite does not) [px], weighted by the mattes.
+  double uncovered_px = 0.0;
+  /// Share of them the plate filled, and the fallback's share (the subject
+  /// layer's picture, as the global warp would show it) [0-1].
+  double plate_share = 0.0;
+  double fallback_share = 0.0;
+  /// The fresh share of the plate [0-1]; its restarts and reprojections so far.
+  double plate_coverage = 0.0;
+  int plate_restarts = 0;
+  int plate_reprojections = 0;
+  /// Mean matte over the background roi [0-1].
+  double matte_mean = 0.0;
+  double matte_ms = 0.0, plate_ms = 0.0, blend_ms = 0.0;
+};
+
+/// The composite (warp mode composite): the subject, warped by the
+/// face-following virtual camera, over the background, warped by the
+/// gyro-only one. Where the background layer still shows the subject, the
+/// background plate shows the scene instead; where the plate has not seen
+/// it, the subject layer's picture is the fallback (the global warp's).
+///
+///   out = m_s S + (1 - m_s) (B + m_b v (P - B) + m_b (1 - v) (S - B))
+///
+/// with S, B the two layers' pictures, m_b the matte in the background
+/// layer's view, m_s the same matte moved into the subject layer's view,
+/// P the plate and v its freshness. Causal; one per stream; not
+/// thread-safe.
+class Compositor {
+ public:
+  static Status Create(const OutputGeometry& output, const CompositeOptions& options,
+                       std::unique_ptr<Compositor>* out);
+
+  /// Forgets the plate, the matte's memory (time jump, scene change).
+  void Reset();
+
+  /// Composes one frame. `subject` and `background` are the two layers'
+  /// pictures (8-bit, same size and type), `region` the subject region in
+  /// the background layer's view (its blend scales the subject's share),
+  /// `time_s` the frame's time. *out may alias `background`.
+  Status Compose(const cv::Mat& subject, const LayerView& subject_view, const cv::Mat& background,
+                 const LayerView& background_view, const SubjectRegion& region, double time_s,
+                 cv::Mat* out);
+
+  const CompositeReport& report() const { return report_; }
+  /// The last matte in the background layer's view over
+  /// report().background_roi, and moved into the subject layer's view over
+  /// report().subject_roi (CV_32F, [0, 1]); the plate's use over the
+  /// background roi (CV_32F: the plate's weight m_b v (1 - m_s) in the
+  /// output).
+  const cv::Mat& background_matte() const { return matte_b_; }
+  const cv::Mat& subject_matte() const { return matte_s_; }
+  const cv::Mat& plate_weight() const { return plate_weight_; }
+  /// The plate as this frame's background camera saw it, over the
+  /// background roi (the images' type).
+  const cv::Mat& plate_sample() const { return plate_sample_; }
+  const BackgroundPlate& plate() const { return plate_; }
+
+ private:
+  Compositor(const OutputGeometry& output, const CompositeOptions& options);
+  // Fills the subject's uncovered pixels of `out` (over the background roi).
+  void FillUncovered(const cv::Mat& subject, const cv::Mat& plate, const cv::Mat& valid,
+                     cv::Mat* out);
+  // The subject over `out` (over the subject roi).
+  void Blend(const cv::Mat& subject, cv::Mat* out);
+
+  const OutputGeometry output_;
+  const CompositeOptions options_;
+  SubjectMatte matte_;
+  BackgroundPlate plate_;
+  CompositeReport report_;
+  cv::Mat matte_b_, matte_s_, plate_weight_, plate_sample_;
+};
+
+}  // namespace steadiface

@@ -1,0 +1,223 @@
+#include "steadiface_core/eval/composite_quality.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "steadiface_core/composite/layer_homography.h"
+#include <opencv2/imgproc.hpp>
+
+namespace steadiface {
+namespace eval {
+namespace {
+
+// Mean of |a - b| over pixels where either is above zero.
+double MeanChange(const cv::Mat& a, const cv::Mat& b) {
+  double sum = 0.0;
+  int n = 0;
+  for (int y = 0; y < a.rows; ++y) {
+    const float* p = a.ptr<float>(y);
+    const float* q = b.ptr<float>(y);
+    for (int x = 0; x < a.cols; ++x) {
+      if (p[x] > 0.0f || q[x] > 0.0f) {
+        sum += std::abs(p[x] - q[x]);
+        ++n;
+      }
+    }
+  }
+  return n > 0 ? sum / n : 0.0;
+}
+
+// Mean absolute difference over `used` (grey levels, mean over channels),
+// added to *error weighted by the pixel count, which goes to *pixels.
+void AddError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& used, double* error,
+              double* pixels) {
+  const double n = cv::countNonZero(used);
+  if (n <= 0) return;
+  cv::Mat diff;
+  cv::absdiff(a, b, diff);
+  const cv::Scalar m = cv::mean(diff, used);
+  double e = 0.0;
+  for (int ch = 0; ch < diff.channels(); ++ch) e += m[ch];
+  *error += n * e / diff.channels();
+  *pixels += n;
+}
+
+}  // namespace
+
+Status CompositeQuality::Create(const sim::Simulator& sim, const Pipeline& pipeline,
+                                std::unique_ptr<CompositeQuality>* out) {
+  WarpOptions w = pipeline.options().warp;
+  w.mode = WarpMode::kGlobal;
+  std::unique_ptr<CompositeQuality> q(new CompositeQuality(sim));
+  const Status s = Warper::Create(pipeline.camera_model(), w, &q->warper_);
+  if (!s.ok()) return s;
+  const CompositeOptions& co = pipeline.options().composite;
+  q->ideal_plate_.reset(new BackgroundPlate(q->warper_->output_geometry(), co.plate));
+  q->plate_distance_px_ = co.plate_distance_px;
+  q->plate_below_ = static_cast<float>(co.plate_below);
+  *out = std::move(q);
+  return Status::Ok();
+}
+
+
+Status CompositeQuality::Add(int index, const Pipeline& pipeline, const PipelineFrame& f) {
+  const Compositor* c = pipeline.compositor();
+  if (c == nullptr || f.output.empty()) return Status::Ok();
+  cv::Mat scene, alpha, truth8, scene_out;
+  Status s = sim_.RenderTruthLayers(index, &scene, &alpha);
+  const StabilizerFrame::LayerPose& b = f.stabilizer.background;
+  const Eigen::Quaterniond R_b = b.valid ? b.R_v : f.stabilizer.R_v;
+  const Eigen::Vector2d t_b = b.valid ? b.t : f.stabilizer.t;
+  if (s.ok()) s = warper_->Warp(alpha, R_b, t_b, f.stabilizer.rows, &truth8);
+  if (s.ok()) s = warper_->Warp(scene, R_b, t_b, f.stabilizer.rows, &scene_out);
+  if (!s.ok()) return s;
+  cv::Mat truth, matte = cv::Mat::zeros(truth8.size(), CV_32F);
+  truth8.convertTo(truth, CV_32F, 1.0 / 255.0);
+  const CompositeReport& r = f.composite.report;
+  if (r.active && !c->background_matte().empty()) {
+    c->background_matte().copyTo(matte(r.background_roi));
+  }
+  AddMatte(index, truth, matte);
+  ideal_plate_->Begin(OutputView(warper_->output_geometry(), R_b, t_b),
+                      ToSeconds(sim_.Truth(index).stamp));
+  AddPlate(*c, r, truth, scene_out);
+  uncovered_ += r.uncovered_px;
+  fallback_ += r.uncovered_px * r.fallback_share;
+  if (!previous_.empty()) {
+    change_ += MeanChange(matte, previous_);
+    truth_change_ += MeanChange(truth, previous_truth_);
+    ++changes_;
+  }
+  previous_ = matte;
+  previous_truth_ = truth;
+  if (!dump_prefix_.empty() && index % dump_every_ == 0) {
+    Dump(index, *c, f, truth, matte, scene_out);
+  }
+  return Status::Ok();
+}
+
+void CompositeQuality::AddMatte(int index, const cv::Mat& truth, const cv::Mat& matte) {
+  // IoU outside the band around the true outline.
+  const cv::Mat T = truth >= 0.5, E = matte >= 0.5;
+  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT,
+                                              cv::Size(2 * kEdgeBandPx + 1, 2 * kEdgeBandPx + 1));
+  cv::Mat grown, shrunk;
+  cv::dilate(T, grown, k);
+  cv::erode(T, shrunk, k);
+  const cv::Mat scored = ~(grown & ~shrunk);
+  if (cv::countNonZero(T & scored) < 200) return;
+  const double inter = cv::countNonZero(T & E & scored), uni = cv::countNonZero((T | E) & scored);
+  iou_.push_back(uni > 0 ? inter / uni : 1.0);
+  iou_frames_.push_back(index);
+  // The matte's outline against the true one.
+  cv::Mat edge_t, edge_e, dist;
+  cv::morphologyEx(T, edge_t, cv::MORPH_GRADIENT, cv::Mat());
+  cv::morphologyEx(E, edge_e, cv::MORPH_GRADIENT, cv::Mat());
+  cv::distanceTransform(~edge_t, dist, cv::DIST_L2, 3);
+  edge_.push_back(cv::countNonZero(edge_e) > 0 ? cv::mean(dist, edge_e)[0] : NAN);
+}
+
+void CompositeQuality::AddPlate(const Compositor& c, const CompositeReport& r,
+                                const cv::Mat& truth, const cv::Mat& scene_out) {
+  // The plate where it filled the output, and the ideal plate there; then
+  // the ideal plate learns this frame where the true subject is not.
+  const bool used_plate = r.active && !c.plate_weight().empty() && !c.plate_sample().empty();
+  if (used_plate) {
+    cv::Mat ideal, ideal_valid;
+    ideal_plate_->Sample(r.background_roi, &ideal, &ideal_valid);
+    AddError(ideal, scene_out(r.background_roi),
+             (c.plate_weight() >= 0.5) & (ideal_valid >= 0.5), &ideal_error_, &ideal_pixels_);
+    AddError(c.plate_sample(), scene_out(r.background_roi), c.plate_weight() >= 0.5,
+             &plate_error_, &plate_pixels_);
+  }
+  if (r.active) {
+    const int g = 2 * plate_distance_px_ + 1;
+    cv::Mat grown;
+    cv::dilate(truth(r.background_roi), grown,
+               cv::getStructuringElement(cv::MORPH_RECT, cv::Size(g, g)));
+    ideal_plate_->Update(scene_out(r.background_roi), grown, r.background_roi, plate_below_);
+  }
+}
+
+void CompositeQuality::Dump(int index, const Compositor& c, const PipelineFrame& f,
+                            const cv::Mat& truth, const cv::Mat& matte,
+                            const cv::Mat& scene_out) const {
+  // Output | matte against truth (white both, red missed, blue extra) | the
+  // plate's weight (green) and its error against the true scene (red, x4)
+  // where it is used.
+  const CompositeReport& r = f.composite.report;
+  cv::Mat out3, m3(matte.size(), CV_8UC3), w3 = cv::Mat::zeros(matte.size(), CV_8UC3);
+  if (f.output.channels() == 1) {
+    cv::cvtColor(f.output, out3, cv::COLOR_GRAY2BGR);
+  } else {
+    out3 = f.output;
+  }
+  for (int y = 0; y < matte.rows; ++y) {
+    for (int x = 0; x < matte.cols; ++x) {
+      const uchar e = cv::saturate_cast<uchar>(255 * matte.at<float>(y, x));
+      const uchar t = cv::saturate_cast<uchar>(255 * truth.at<float>(y, x));
+      m3.at<cv::Vec3b>(y, x) = cv::Vec3b(e, std::min(e, t), t);
+    }
+  }
+  if (r.active && !c.plate_weight().empty() && !c.plate_sample().empty()) {
+    cv::Mat w8, diff, grey;
+    c.plate_weight().convertTo(w8, CV_8U, 255.0);
+    cv::absdiff(c.plate_sample(), scene_out(r.background_roi), diff);
+    if (diff.channels() == 1) {
+      grey = diff;
+    } else {
+      cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+    }
+    grey.convertTo(grey, CV_8U, 4.0);
+    grey.setTo(0, c.plate_weight() < 0.5);
+    std::vector<cv::Mat> ch = {cv::Mat::zeros(w8.size(), CV_8U), w8, grey};
+    cv::merge(ch, w3(r.background_roi));
+  }
+  cv::Mat row;
+  cv::hconcat(std::vector<cv::Mat>{out3, m3, w3}, row);
+  char name[32];
+  std::snprintf(name, sizeof(name), "_%03d.png", index);
+  cv::imwrite(dump_prefix_ + name, row);
+}
+
+CompositeQualityScore CompositeQuality::Compute() const {
+  CompositeQualityScore q;
+  q.frames = static_cast<int>(iou_.size());
+  if (!iou_.empty()) {
+    double sum = 0.0;
+    q.matte_iou_min = 2.0;
+    for (size_t i = 0; i < iou_.size(); ++i) {
+      sum += iou_[i];
+      if (iou_[i] < q.matte_iou_min) {
+        q.matte_iou_min = iou_[i];
+        q.matte_iou_min_frame = iou_frames_[i];
+      }
+    }
+    q.matte_iou_mean = sum / iou_.size();
+    double e = 0.0, step = 0.0;
+    int n = 0;
+    for (size_t i = 0; i < edge_.size(); ++i) {
+      if (!std::isfinite(edge_[i])) continue;
+      e += edge_[i];
+      ++n;
+      if (i > 0 && std::isfinite(edge_[i - 1])) step = std::max(step, std::abs(edge_[i] - edge_[i - 1]));
+    }
+    if (n > 0) q.edge_error_px = e / n;
+    q.edge_max_step_px = step;
+  }
+  if (plate_pixels_ > 0.0) q.plate_mae = plate_error_ / plate_pixels_;
+  q.plate_pixels = plate_pixels_;
+  if (ideal_pixels_ > 0.0) q.ideal_plate_mae = ideal_error_ / ideal_pixels_;
+  q.ideal_plate_pixels = ideal_pixels_;
+  if (uncovered_ > 0.0) q.fallback_share = fallback_ / uncovered_;
+  if (changes_ > 0) {
+    q.matte_change = change_ / changes_;
+    q.truth_change = truth_change_ / changes_;
+  }
+  return q;
+}
+
+}  // namespace eval
+}  // namespace steadiface

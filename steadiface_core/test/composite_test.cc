@@ -1,0 +1,324 @@
+// The composite's pieces on synthetic pictures with known geometry: the
+// homography between two virtual cameras, the background plate, the subject
+// matte and the compositor.
+#include <cmath>
+#include <memory>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "steadiface_core/common/so3.h"
+#include "steadiface_core/composite/background_plate.h"
+#include "steadiface_core/composite/compositor.h"
+#include "steadiface_core/composite/guided_filter.h"
+#include "steadiface_core/composite/layer_homography.h"
+#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/warp/warper.h"
+#include "test_util.h"
+
+namespace steadiface {
+namespace {
+
+OutputGeometry Geometry() {
+  OutputGeometry g;
+  EXPECT_TRUE(OutputGeometry::Create(testing_util::Model640x360(), OutputOptions(), &g).ok());
+  return g;
+}
+
+Eigen::Quaterniond Rot(double rx, double ry, double rz) {
+  return ExpSO3(Eigen::Vector3d(rx, ry, rz));
+}
+
+// A world-anchored scene: a textured panorama seen by the reference view
+// (identity rotation, the panorama's pixel K), rendered into any view.
+struct Scene {
+  LayerView reference;
+  cv::Mat texture;
+  Scene(const OutputGeometry& g) {
+    reference = OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero());
+    reference.K(0, 2) += 200;
+    reference.K(1, 2) += 150;
+    texture = cv::Mat(g.height() + 300, g.width() + 400, CV_8UC3);
+    cv::RNG rng(7);
+    rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(texture, texture, cv::Size(0, 0), 2.0);
+    texture.convertTo(texture, -1, 3.0, -250.0);  // contrast back up
+  }
+  cv::Mat Render(const LayerView& v, const cv::Size& size) const {
+    cv::Mat out;
+    const cv::Rect src(0, 0, texture.cols, texture.rows), dst(0, 0, size.width, size.height);
+    cv::warpPerspective(texture, out, RectMap(HomographyBetween(reference, v), src, 1.0, dst, 1.0),
+                        size, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REFLECT);
+    return out;
+  }
+};
+
+double MeanAbs(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+  cv::Mat d;
+  cv::absdiff(a, b, d);
+  const cv::Scalar m = cv::mean(d, mask);
+  return (m[0] + m[1] + m[2]) / 3.0;
+}
+
+TEST(LayerHomographyTest, MapsAWorldDirectionBetweenTwoVirtualCameras) {
+  const OutputGeometry g = Geometry();
+  const LayerView a = OutputView(g, Rot(0.02, -0.03, 0.01), Eigen::Vector2d(0.01, -0.02));
+  const LayerView b = OutputView(g, Rot(-0.01, 0.02, 0.03), Eigen::Vector2d(-0.015, 0.005));
+  for (const Eigen::Vector3d& d : {Eigen::Vector3d(0.1, -0.05, 1.0), Eigen::Vector3d(-0.2, 0.1, 1.0)}) {
+    const Eigen::Vector2d pa = (a.K * (a.R * d)).hnormalized();
+    const Eigen::Vector2d pb = (b.K * (b.R * d)).hnormalized();
+    EXPECT_LT(((HomographyBetween(b, a) * pa.homogeneous()).hnormalized() - pb).norm(), 1e-9);
+  }
+  // The output's pixels follow OutputGeometry's own mapping (t moves the
+  // principal point by t / scale).
+  const LayerView c = OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d(0.01, 0.0));
+  const LayerView z = OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero());
+  const Eigen::Vector2d shift = (HomographyBetween(c, z) * Eigen::Vector3d(100, 50, 1)).hnormalized();
+  const Eigen::Vector2d expected =
+      g.VirtualToOutputPixel(g.OutputPixelToVirtual(Eigen::Vector2d(100, 50)) + Eigen::Vector2d(0.01, 0));
+  EXPECT_LT((shift - expected).norm(), 1e-9);
+}
+
+TEST(LayerHomographyTest, RectMapSamplesTheRightPixelAtAnyScale) {
+  // A dot at view pixel (120, 80) of a 1/4-scale picture lands at (120, 80)
+  // of a full-scale rectangle starting at (100, 60) through the identity.
+  cv::Mat small = cv::Mat::zeros(90, 160, CV_32F);
+  small.at<float>(80 / 4, 120 / 4) = 1.0f;  // view pixels 120..123 x 80..83
+  cv::Mat out;
+  const cv::Rect dst(100, 60, 40, 40);
+  cv::warpPerspective(small, out, RectMap(Eigen::Matrix3d::Identity(), cv::Rect(0, 0, 640, 360), 0.25,
+                                          dst, 1.0),
+                      dst.size(), cv::INTER_NEAREST | cv::WARP_INVERSE_MAP);
+  EXPECT_EQ(out.at<float>(80 - 60, 120 - 100), 1.0f);
+  EXPECT_EQ(out.at<float>(83 - 60, 123 - 100), 1.0f);
+  EXPECT_EQ(out.at<float>(84 - 60, 124 - 100), 0.0f);
+  EXPECT_EQ(cv::countNonZero(out), 16);
+}
+
+TEST(BackgroundPlateTest, HoldsTheSceneWhatASubjectUncoversAndForgetsOldPixels) {
+  const OutputGeometry g = Geometry();
+  const Scene scene(g);
+  BackgroundPlateOptions o;
+  o.max_age_s = 1.0;
+  BackgroundPlate plate(g, o);
+  const cv::Size size(g.width(), g.height());
+  const cv::Rect roi(200, 80, 240, 200);
+  // The background camera sways by up to 1.5 degrees; a subject (a square
+  // of matte 1) moves across the roi and back, never over its right quarter
+  // after frame 0.
+  double mae = 0.0;
+  int measured = 0;
+  for (int i = 0; i < 60; ++i) {
+    const double t = i / 30.0;
+    const LayerView v = OutputView(g, Rot(0.02 * std::sin(2 * t), 0.025 * std::sin(3 * t), 0.0),
+                                   Eigen::Vector2d::Zero());
+    plate.Begin(v, t);
+    const cv::Mat picture = scene.Render(v, size);
+    cv::Mat matte = cv::Mat::zeros(roi.size(), CV_32F);
+    const int x0 = 20 + static_cast<int>(100 * (1 - std::cos(2 * M_PI * t / 2)) / 2);
+    matte(cv::Rect(x0, 40, 80, 120)).setTo(1.0f);
+    if (i >= 40) {  // the plate where the subject is now was seen before
+      cv::Mat colour, valid;
+      plate.Sample(roi, &colour, &valid);
+      const cv::Mat covered = (matte > 0.5) & (valid > 0.99);
+      ASSERT_GT(cv::countNonZero(covered), 2000) << "frame " << i;
+      mae += MeanAbs(colour, picture(roi), covered);
+      ++measured;
+    }
+    EXPECT_TRUE(plate.Update(picture(roi), matte, roi, 0.1f));
+  }
+  EXPECT_LT(mae / measured, 4.0);  // bilinear resampling of a sharp texture
+  // Unseen for longer than max_age: expired.
+  plate.Begin(OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero()), 10.0);
+  cv::Mat colour, valid;
+  plate.Sample(roi, &colour, &valid);
+  EXPECT_EQ(cv::countNonZero(valid > 0.0), 0);
+  EXPECT_EQ(plate.restarts(), 0);
+}
+
+TEST(BackgroundPlateTest, RestartsOnAsceneCutAndOnALargeTurnAndReprojectsOnADrift) {
+  const OutputGeometry g = Geometry();
+  const Scene scene(g);
+  BackgroundPlate plate(g, BackgroundPlateOptions());
+  const cv::Size size(g.width(), g.height());
+  const cv::Rect roi(100, 60, 300, 200);
+  const cv::Mat none = cv::Mat::zeros(roi.size(), CV_32F);
+  LayerView v = OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero());
+  plate.Begin(v, 0.0);
+  EXPECT_TRUE(plate.Update(scene.Render(v, size)(roi), none, roi, 0.1f));
+  // The same view, another scene: a cut.
+  plate.Begin(v, 0.033);
+  cv::Mat other = 255 - scene.Render(v, size);
+  EXPECT_FALSE(plate.Update(other(roi), none, roi, 0.1f));
+  EXPECT_EQ(plate.restarts(), 1);
+  // A slow pan of 10 degrees (130 px, more than the 96 px margin):
+  // reprojected, the scene still where it was.
+  for (int i = 0; i <= 25; ++i) {
+    v = OutputView(g, Rot(0.0, 0.007 * i, 0.0), Eigen::Vector2d::Zero());
+    plate.Begin(v, 0.1 + i / 30.0);
+    EXPECT_TRUE(plate.Update(scene.Render(v, size)(roi), none, roi, 0.1f));
+  }
+  EXPECT_GE(plate.reprojections(), 1);
+  EXPECT_EQ(plate.restarts(), 1);
+  cv::Mat colour, valid;
+  plate.Sample(roi, &colour, &valid);
+  EXPECT_LT(MeanAbs(colour, scene.Render(v, size)(roi), valid > 0.99), 5.0);
+  // A turn of 30 degrees: restarted.
+  plate.Begin(OutputView(g, Rot(0.0, 0.52, 0.0), Eigen::Vector2d::Zero()), 2.0);
+  EXPECT_EQ(plate.restarts(), 2);
+}
+
+// The subject region of a disc of radius r around c (head only).
+SubjectRegion Disc(const Eigen::Vector2d& c, double r) {
+  SubjectRegion region;
+  region.valid = true;
+  region.head_centre = c;
+  region.face_centre = c;
+  region.head_axes = Eigen::Vector2d(r, r);
+  region.jaw_width = 1.4 * r;
+  region.face_height = 1.2 * r;
+  region.torso = false;
+  region.blend = 1.0;
+  return region;
+}
+
+TEST(CompositorTest, PutsTheSubjectWhereItsLayerHoldsItAndTheSceneWhereItsLayerHoldsIt) {
+  // The scene stands still in the background layer. The subject, a textured
+  // disc of radius 60 px, stands still in the subject layer, whose view
+  // swings by +-50 px against the background's: what it uncovers must come
+  // from the plate, and the disc must be where the subject layer puts it.
+  const OutputGeometry g = Geometry();
+  const Scene scene(g);
+  const cv::Size size(g.width(), g.height());
+  std::unique_ptr<Compositor> c;
+  ASSERT_TRUE(Compositor::Create(g, CompositeOptions(), &c).ok());
+  cv::Mat face(size, CV_8UC3);
+  cv::RNG rng(3);
+  rng.fill(face, cv::RNG::UNIFORM, cv::Scalar(150, 100, 60), cv::Scalar(230, 170, 120));
+  const Eigen::Vector2d centre(320, 190);
+  const double r = 60;
+  cv::Mat disc = cv::Mat::zeros(size, CV_8U);
+  cv::circle(disc, cv::Point(320, 190), 60, cv::Scalar(255), -1, cv::LINE_AA);
+  const LayerView background = OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero());
+  double iou_sum = 0.0, mae_sum = 0.0;
+  int n = 0;
+  for (int i = 0; i < 75; ++i) {
+    const double t = i / 30.0;
+    const double swing = 0.09 * std::sin(2 * M_PI * 1.2 * t);  // ~+-50 px
+    const LayerView subject = OutputView(g, Rot(0.0, swing, 0.0), Eigen::Vector2d::Zero());
+    // The subject layer's picture: the scene as that view sees it, the disc
+    // fixed in it. The background layer's: the scene, the disc where the
+    // subject view's disc lands in the background view.
+    cv::Mat S = scene.Render(subject, size);
+    face.copyTo(S, disc);
+    const Eigen::Matrix3d H_bs = HomographyBetween(background, subject);
+    cv::Mat disc_b, face_b;
+    const cv::Rect whole(0, 0, size.width, size.height);
+    cv::warpPerspective(disc, disc_b, RectMap(H_bs.inverse(), whole, 1.0, whole, 1.0), size,
+                        cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+    cv::warpPerspective(face, face_b, RectMap(H_bs.inverse(), whole, 1.0, whole, 1.0), size,
+                        cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+    cv::Mat B = scene.Render(background, size);
+    face_b.copyTo(B, disc_b > 127);
+    const Eigen::Vector2d c_b = (H_bs * centre.homogeneous()).hnormalized();
+    cv::Mat out;
+    ASSERT_TRUE(c->Compose(S, subject, B, background, Disc(c_b, r), t, &out).ok());
+    if (i < 45) continue;  // a cycle and a half to learn the scene
+    // The matte against the disc in the background view (3 px from its edge
+    // not scored).
+    cv::Mat truth = cv::Mat::zeros(size, CV_8U), est = cv::Mat::zeros(size, CV_8U);
+    cv::circle(truth, cv::Point2d(c_b.x(), c_b.y()), 57, cv::Scalar(255), -1);
+    cv::Mat band = cv::Mat::zeros(size, CV_8U);
+    cv::circle(band, cv::Point2d(c_b.x(), c_b.y()), 60, cv::Scalar(255), 7);
+    const CompositeReport& rep = c->report();
+    est(rep.background_roi).setTo(255, c->background_matte() >= 0.5);
+    const cv::Mat scored = band == 0;
+    cv::Mat t_in = truth & scored, e_in = est & scored;
+    iou_sum += static_cast<double>(cv::countNonZero(t_in & e_in)) / cv::countNonZero(t_in | e_in);
+    // The output against the truth: the disc where the subject layer holds
+    // it (the centre), the scene as the background layer sees it elsewhere.
+    cv::Mat expected = scene.Render(background, size);
+    face.copyTo(expected, disc);
+    cv::Mat away;
+    cv::dilate(disc, away, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(15, 15)));
+    cv::Mat edge_b;
+    cv::dilate(disc_b, edge_b, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(15, 15)));
+    cv::Mat near_disc;  // scored: the disc's interior and the uncovered scene, edges aside
+    cv::erode(disc, near_disc, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(15, 15)));
+    const cv::Mat uncovered = (edge_b > 0) & (away == 0);
+    const cv::Mat scored_out = (near_disc > 0) | uncovered;
+    mae_sum += MeanAbs(out, expected, scored_out);
+    EXPECT_GT(rep.plate_share, 0.8) << "frame " << i;
+    ++n;
+  }
+  EXPECT_GT(iou_sum / n, 0.9);
+  EXPECT_LT(mae_sum / n, 8.0);
+}
+
+TEST(CompositorTest, WithoutASubjectTheOutputIsTheBackgroundLayer) {
+  const OutputGeometry g = Geometry();
+  std::unique_ptr<Compositor> c;
+  ASSERT_TRUE(Compositor::Create(g, CompositeOptions(), &c).ok());
+  cv::Mat S(g.height(), g.width(), CV_8UC3, cv::Scalar(10, 20, 30));
+  cv::Mat B(g.height(), g.width(), CV_8UC3, cv::Scalar(200, 100, 50)), out;
+  const LayerView v = OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero());
+  ASSERT_TRUE(c->Compose(S, v, B, v, SubjectRegion(), 0.0, &out).ok());
+  EXPECT_FALSE(c->report().active);
+  EXPECT_EQ(cv::norm(out, B, cv::NORM_INF), 0.0);
+  // Mismatched pictures are refused with a message.
+  cv::Mat small(10, 10, CV_8UC3);
+  EXPECT_FALSE(c->Compose(small, v, B, v, SubjectRegion(), 0.0, &out).ok());
+}
+
+TEST(CompositeOptionsTest, ValidationNamesTheBadField) {
+  CompositeOptions o;
+  EXPECT_TRUE(ValidateCompositeOptions(o).ok());
+  o.matte.scale = 0;
+  Status s = ValidateCompositeOptions(o);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("scale"), std::string::npos);
+  o = CompositeOptions();
+  o.plate.max_age_s = -1;
+  s = ValidateCompositeOptions(o);
+  EXPECT_NE(s.message().find("max_age_s"), std::string::npos);
+  o = CompositeOptions();
+  o.plate_distance_px = 100;
+  EXPECT_FALSE(ValidateCompositeOptions(o).ok());
+}
+
+TEST(GuidedFilterTest, KeepsAnEdgeTheGuideShowsAndSmoothsWhereItShowsNone) {
+  // A step in the guide at x = 50; the input a noisy, blurred step at x = 46.
+  cv::Mat guide(40, 100, CV_32F, cv::Scalar(0.2f)), p(40, 100, CV_32F, cv::Scalar(0.0f));
+  guide(cv::Rect(50, 0, 50, 40)).setTo(0.8f);
+  p(cv::Rect(46, 0, 54, 40)).setTo(1.0f);
+  cv::Mat q;
+  GuidedFilter(guide, p, 8, 1e-3, &q);
+  EXPECT_LT(q.at<float>(20, 30), 0.1f);
+  EXPECT_GT(q.at<float>(20, 70), 0.9f);
+  // The transition sits on the guide's edge: between 49 and 50 it jumps.
+  EXPECT_GT(q.at<float>(20, 50) - q.at<float>(20, 49), 0.3f);
+  // The fast form (coefficients at half resolution, applied to the full
+  // guide) stays within 0.1 of the exact one away from the edge.
+  cv::Mat g2, p2, a, b, A, B;
+  cv::resize(guide, g2, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+  cv::resize(p, p2, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+  GuidedFilterCoefficients(g2, p2, 4, 1e-3, &a, &b);
+  cv::resize(a, A, guide.size(), 0, 0, cv::INTER_LINEAR);
+  cv::resize(b, B, guide.size(), 0, 0, cv::INTER_LINEAR);
+  const cv::Mat fast = A.mul(guide) + B;
+  EXPECT_LT(std::abs(fast.at<float>(20, 30) - q.at<float>(20, 30)), 0.1f);
+  EXPECT_LT(std::abs(fast.at<float>(20, 70) - q.at<float>(20, 70)), 0.1f);
+}
+
+TEST(WarpModeTest, ParsesComposite) {
+  WarpMode m;
+  ASSERT_TRUE(ParseWarpMode("composite", &m).ok());
+  EXPECT_EQ(m, WarpMode::kComposite);
+  EXPECT_STREQ(WarpModeName(m), "composite");
+  const Status s = ParseWarpMode("mosaic", &m);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("composite"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace steadiface
