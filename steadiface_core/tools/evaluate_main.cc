@@ -198,14 +198,16 @@ std::pair<std::string, std::string> CompositeRow(const std::string& preset,
      << f(q.matte_iou_min, "%.3f") << " (" << q.matte_iou_min_frame << ") | "
      << f(q.plate_mae, "%.2f") << " (" << f(q.ideal_plate_mae, "%.2f") << ") | "
      << f(q.plate_pixels, "%.0f") << " | "
-     << f(q.fallback_share, "%.3f") << " | " << f(q.matte_change, "%.4f") << " | "
+     << f(q.fallback_share, "%.3f") << " | " << f(q.uncovered_mae, "%.2f") << " ("
+     << f(q.uncovered_pixels, "%.0f") << ") | " << f(q.matte_change, "%.4f") << " | "
      << f(q.truth_change, "%.4f") << " | " << f(q.edge_error_px, "%.2f") << " | "
      << f(q.edge_max_step_px, "%.2f") << " |\n";
   csv << preset << "," << q.frames << "," << f(q.matte_iou_mean, "%.4f") << ","
       << f(q.matte_iou_min, "%.4f") << "," << q.matte_iou_min_frame << ","
       << f(q.plate_mae, "%.3f") << "," << f(q.ideal_plate_mae, "%.3f") << ","
       << f(q.plate_pixels, "%.0f") << ","
-      << f(q.fallback_share, "%.4f") << "," << f(q.matte_change, "%.5f") << ","
+      << f(q.fallback_share, "%.4f") << "," << f(q.uncovered_mae, "%.3f") << ","
+      << f(q.uncovered_pixels, "%.0f") << "," << f(q.matte_change, "%.5f") << ","
       << f(q.truth_change, "%.5f") << "," << f(q.edge_error_px, "%.3f") << ","
       << f(q.edge_max_step_px, "%.3f") << "\n";
   return {md.str(), csv.str()};
@@ -265,6 +267,9 @@ int main(int argc, char** argv) {
   cl.Double("--matte-motion-memory", &composite.matte.motion_memory);
   cl.Double("--plate-max-age", &composite.plate.max_age_s);
   cl.Int("--plate-distance", &composite.plate_distance_px);
+  cl.Double("--plate-below", &composite.plate_below);
+  cl.Double("--plate-confidence", &composite.matte.plate_confidence);
+  cl.Double("--plate-outlier", &composite.plate.outlier_level);
   cl.ClearFlag("--yield-to-background", &blend.yield_to_subject);
   cl.Double("--offset-lowpass", &blend.offset_lowpass_hz);
   cl.Value("--size", "WxH", [&](const std::string& v) {
@@ -570,11 +575,12 @@ int main(int argc, char** argv) {
   if (!composite_rows.empty()) {
     std::ofstream csv(out_dir + "/composite_quality.csv");
     std::cout << "\n| preset | frames | matte IoU mean | matte IoU min (frame) | plate MAE grey |"
-                 " plate px | fallback share | matte change | truth change | edge error px |"
-                 " edge max step px |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+                 " plate px | fallback share | uncovered MAE grey (px) | matte change | truth change |"
+                 " edge error px | edge max step px |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     csv << "preset,frames,matte_iou_mean,matte_iou_min,matte_iou_min_frame,plate_mae,"
            "ideal_plate_mae,plate_px,"
-           "fallback_share,matte_change,truth_change,edge_error_px,edge_max_step_px\n";
+           "fallback_share,uncovered_mae,uncovered_px,matte_change,truth_change,edge_error_px,"
+           "edge_max_step_px\n";
     for (const auto& r : composite_rows) {
       std::cout << r.first;
       csv << r.second;

@@ -417,6 +417,7 @@ void ReadComposite(Reader& r, steadiface::CompositeOptions* c) {
   r.Num("composite/matte/plate_level", &c->matte.plate_level);
   r.Num("composite/matte/motion_level", &c->matte.motion_level);
   r.Num("composite/matte/motion_memory", &c->matte.motion_memory);
+  r.Num("composite/matte/plate_confidence", &c->matte.plate_confidence);
   r.Num("composite/matte/colour_weight", &c->matte.colour_weight);
   r.Num("composite/matte/temporal", &c->matte.temporal);
   r.Int("composite/matte/edge_radius", &c->matte.edge_radius_px);
@@ -424,6 +425,7 @@ void ReadComposite(Reader& r, steadiface::CompositeOptions* c) {
   r.Num("composite/plate/margin", &c->plate.margin);
   r.Num("composite/plate/max_age", &c->plate.max_age_s);
   r.Num("composite/plate/update_rate", &c->plate.update_rate);
+  r.Num("composite/plate/outlier_level", &c->plate.outlier_level);
   r.Num("composite/plate/reset_angle", &c->plate.reset_angle_deg);
   r.Num("composite/plate/scene_cut_level", &c->plate.scene_cut_level);
 }

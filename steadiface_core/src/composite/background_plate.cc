@@ -26,6 +26,9 @@ Status ValidateBackgroundPlateOptions(const BackgroundPlateOptions& o) {
   if (!In(o.reset_angle_deg, 0.1, 90.0)) {
     return Status::Error("composite.plate: reset_angle_deg must be in [0.1, 90] deg");
   }
+  if (!In(o.outlier_level, 1.0, 255.0)) {
+    return Status::Error("composite.plate: outlier_level must be in [1, 255]");
+  }
   if (!In(o.scene_cut_level, 1.0, 255.0)) {
     return Status::Error("composite.plate: scene_cut_level must be in [1, 255]");
   }
@@ -117,6 +120,9 @@ void BackgroundPlate::Sample(const cv::Rect& roi, cv::Mat* colour, cv::Mat* vali
       v[x] = std::min(1.0f, std::max(0.0f, (max_age - age) / (0.25f * max_age)));
     }
   }
+  // The colour is interpolated from the four nearest plate pixels: next to
+  // an unseen one it is not the scene's.
+  cv::erode(*valid, *valid, cv::Mat());
 }
 
 bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
@@ -139,6 +145,7 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
                       cv::BORDER_CONSTANT, cv::Scalar(1.0));
   const float now = static_cast<float>(now_), max_age = static_cast<float>(options_.max_age_s);
   const float rate = static_cast<float>(options_.update_rate);
+  const int outlier = static_cast<int>(options_.outlier_level);
   double diff = 0.0;
   int compared = 0;
   for (int y = 0; y < target.height; ++y) {
@@ -149,15 +156,18 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
     for (int x = 0; x < target.width; ++x) {
       if (!(m[x] < background_below)) continue;
       const bool fresh = now - s[x] < max_age;
-      const float a = fresh ? rate : 1.0f;
       int d = 0;
-      for (int c = cn * x; c < cn * (x + 1); ++c) {
-        d += std::abs(in[c] - p[c]);
-        p[c] = cv::saturate_cast<uchar>(p[c] + a * (in[c] - p[c]));
-      }
+      for (int c = cn * x; c < cn * (x + 1); ++c) d += std::abs(in[c] - p[c]);
       if (fresh) {
         diff += static_cast<double>(d) / cn;
         ++compared;
+        // A fresh pixel that disagrees this much is more likely a subject's
+        // edge than the scene: not taken; it expires if the scene changed.
+        if (d > outlier * cn) continue;
+      }
+      const float a = fresh ? rate : 1.0f;
+      for (int c = cn * x; c < cn * (x + 1); ++c) {
+        p[c] = cv::saturate_cast<uchar>(p[c] + a * (in[c] - p[c]));
       }
       s[x] = now;
     }

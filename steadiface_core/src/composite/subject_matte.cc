@@ -52,6 +52,9 @@ Status ValidateSubjectMatteOptions(const SubjectMatteOptions& o) {
   if (!In(o.plate_level, 1.0, 255.0) || !In(o.motion_level, 1.0, 255.0)) {
     return Status::Error("composite.matte: plate_level and motion_level must be in [1, 255]");
   }
+  if (!In(o.plate_confidence, 0.0, 8.0)) {
+    return Status::Error("composite.matte: plate_confidence must be in [0, 8]");
+  }
   if (!In(o.motion_memory, 0.0, 0.99)) {
     return Status::Error("composite.matte: motion_memory must be in [0, 0.99]");
   }
@@ -251,7 +254,8 @@ void SubjectMatte::Evidence(const MatteInputs& in, const LowRes& low, const cv::
         L[x] = -8.0f;
         continue;
       }
-      float l = PriorLogOdds(in.region, p, o.prior_softness);
+      const float prior = PriorLogOdds(in.region, p, o.prior_softness);
+      float l = prior;
       if (plate) {
         const uchar* pl = low.plate.ptr<uchar>(y) + cn * x;
         float d = 0.0f;
@@ -277,8 +281,12 @@ void SubjectMatte::Evidence(const MatteInputs& in, const LowRes& low, const cv::
       // still in the background layer while it moved in the subject layer,
       // now and over the recent frames. A subject pixel the matte missed must
       // not enter the plate, or the plate would then call it scene; the
-      // landmarks' region is no proof, a subject may reach beyond it.
-      V[x] = std::isfinite(now) && now <= -1.0f && acc <= -1.0f ? 1.0f : 0.0f;
+      // landmarks' region alone is no proof, a subject may reach beyond it.
+      // Or, where nothing moves (a plain wall), outside the landmarks'
+      // region and confidently the scene by all the evidence together.
+      const bool moved_as_scene = std::isfinite(now) && now <= -1.0f && acc <= -1.0f;
+      const bool confident = prior <= -1.0f && L[x] <= -static_cast<float>(o.plate_confidence);
+      V[x] = moved_as_scene || confident ? 1.0f : 0.0f;
     }
   }
 }

@@ -72,7 +72,15 @@ Status CompositeQuality::Add(int index, const Pipeline& pipeline, const Pipeline
   const Eigen::Vector2d t_b = b.valid ? b.t : f.stabilizer.t;
   if (s.ok()) s = warper_->Warp(alpha, R_b, t_b, f.stabilizer.rows, &truth8);
   if (s.ok()) s = warper_->Warp(scene, R_b, t_b, f.stabilizer.rows, &scene_out);
+  cv::Mat alpha_s;  // the true subject in the subject layer's view
+  if (s.ok()) s = warper_->Warp(alpha, f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows, &alpha_s);
   if (!s.ok()) return s;
+  if (f.output.type() == scene_out.type()) {
+    // Clearly uncovered: the subject's own soft edge (which the subject
+    // layer rightly draws) left out on both sides.
+    AddError(f.output, scene_out, (truth8 >= 242) & (alpha_s <= 12), &uncovered_error_,
+             &uncovered_pixels_);
+  }
   cv::Mat truth, matte = cv::Mat::zeros(truth8.size(), CV_32F);
   truth8.convertTo(truth, CV_32F, 1.0 / 255.0);
   const CompositeReport& r = f.composite.report;
@@ -212,6 +220,8 @@ CompositeQualityScore CompositeQuality::Compute() const {
   if (ideal_pixels_ > 0.0) q.ideal_plate_mae = ideal_error_ / ideal_pixels_;
   q.ideal_plate_pixels = ideal_pixels_;
   if (uncovered_ > 0.0) q.fallback_share = fallback_ / uncovered_;
+  if (uncovered_pixels_ > 0.0) q.uncovered_mae = uncovered_error_ / uncovered_pixels_;
+  q.uncovered_pixels = uncovered_pixels_;
   if (changes_ > 0) {
     q.matte_change = change_ / changes_;
     q.truth_change = truth_change_ / changes_;

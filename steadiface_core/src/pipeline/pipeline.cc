@@ -265,6 +265,8 @@ Status Pipeline::CompositeStep(const cv::Mat& image, Time stamp, const FaceObser
                            f.output, OutputView(geometry, R_b, t_b), f.composite.region,
                            ToSeconds(stamp), &f.output);
   f.composite.report = compositor_->report();
+  f.timings.composite_ms = f.composite.report.matte_ms + f.composite.report.plate_ms +
+                           f.composite.report.blend_ms;
   return s;
 }
 

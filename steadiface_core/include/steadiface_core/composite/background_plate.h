@@ -22,6 +22,10 @@ struct BackgroundPlateOptions {
   /// Weight of this frame where the plate already holds the pixel (the rest
   /// is the plate's; 1 = newest only) [-].
   double update_rate = 0.5;
+  /// A fresh pixel is not updated by a value that differs from it by more
+  /// than this (a subject's soft edge the matte let through); it expires
+  /// after max_age_s if the scene really changed [grey levels].
+  double outlier_level = 40.0;
   /// The plate restarts when the background camera has turned by more than
   /// this since the plate's anchor [deg]; below it, the plate is reprojected
   /// once when the view leaves it.

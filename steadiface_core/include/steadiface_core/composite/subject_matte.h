@@ -35,6 +35,10 @@ struct SubjectMatteOptions {
   /// (where the subject stands still), each frame's decaying by this factor
   /// per frame [-].
   double motion_memory = 0.85;
+  /// Outside the landmarks' region, the plate takes pixels whose log-odds
+  /// are below minus this even where nothing moved (plain walls; elsewhere
+  /// it needs the motion evidence) [-].
+  double plate_confidence = 4.0;
   /// Weight of the online colour model's log-likelihood ratio [-].
   double colour_weight = 0.7;
   /// Weight of the previous frame's log-odds, moved with the subject [-].

@@ -37,6 +37,12 @@ struct CompositeQualityScore {
   double ideal_plate_pixels = 0.0;
   /// Share of the uncovered pixels the fallback filled [0-1].
   double fallback_share = NAN;
+  /// End to end where the subject truly uncovered the scene (the true
+  /// subject covers the pixel in the background layer's view, coverage
+  /// >= 0.95, and not in the subject layer's, <= 0.05): the output against the true scene, whatever filled
+  /// it (plate, fallback, or a matte error) [grey levels]; the pixels.
+  double uncovered_mae = NAN;
+  double uncovered_pixels = 0.0;
   /// The matte's mean per-frame change over the pixels it covers on either
   /// frame [0-1], and the true subject's for comparison.
   double matte_change = NAN, truth_change = NAN;
@@ -86,6 +92,7 @@ class CompositeQuality {
   std::vector<double> iou_, edge_;
   std::vector<int> iou_frames_;
   double plate_error_ = 0.0, plate_pixels_ = 0.0;
+  double uncovered_error_ = 0.0, uncovered_pixels_ = 0.0;
   double uncovered_ = 0.0, fallback_ = 0.0;
   double change_ = 0.0, truth_change_ = 0.0;
   int changes_ = 0;

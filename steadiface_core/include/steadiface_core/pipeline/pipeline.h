@@ -64,6 +64,8 @@ struct PipelineTimings {
   double mesh_ms = 0.0;
   double maps_ms = 0.0;
   double remap_ms = 0.0;
+  /// Composite mode: the matte, the plate and the blend.
+  double composite_ms = 0.0;
   double total_ms = 0.0;
 };
 
