@@ -64,7 +64,7 @@ void BM_PipelineFrame(benchmark::State& state) {
   if (state.range(3) == 2) po.warp.mode = WarpMode::kComposite;
   std::unique_ptr<Pipeline> p;
   size_t g = 0, i = 0;
-  std::vector<double> face, stab, warp, mesh, composite, total;
+  std::vector<double> face, stab, warp, mesh, composite, matte, plate, blend, total;
   double check_sum = 0.0, check_max = 0.0;
   // A fresh pipeline that has acquired the face on the first frame.
   auto restart = [&]() -> bool {
@@ -100,6 +100,9 @@ void BM_PipelineFrame(benchmark::State& state) {
     warp.push_back(out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms);
     mesh.push_back(out.timings.mesh_ms);
     composite.push_back(out.timings.composite_ms);
+    matte.push_back(out.composite.report.matte_ms);
+    plate.push_back(out.composite.report.plate_ms);
+    blend.push_back(out.composite.report.blend_ms);
     total.push_back(out.timings.total_ms);
     check_sum += out.timings.check_ms;
     check_max = std::max(check_max, out.timings.check_ms);
@@ -109,6 +112,9 @@ void BM_PipelineFrame(benchmark::State& state) {
   state.counters["warp_ms"] = Percentile(warp, 0.5);
   state.counters["mesh_ms"] = Percentile(mesh, 0.5);
   state.counters["composite_ms"] = Percentile(composite, 0.5);
+  state.counters["matte_ms"] = Percentile(matte, 0.5);
+  state.counters["plate_ms"] = Percentile(plate, 0.5);
+  state.counters["blend_ms"] = Percentile(blend, 0.5);
   // The gyro-vs-video check runs on one frame pair in `stride`: its mean
   // per frame, and the checked frames' cost.
   state.counters["check_mean_ms"] = total.empty() ? 0.0 : check_sum / total.size();

@@ -411,6 +411,7 @@ void ReadLayered(Reader& r, steadiface::LayeredWarpOptions* lw) {
 void ReadComposite(Reader& r, steadiface::CompositeOptions* c) {
   r.Num("composite/plate_below", &c->plate_below);
   r.Int("composite/plate_distance", &c->plate_distance_px);
+  r.Int("composite/plate_row_step", &c->plate_row_step);
   r.Int("composite/matte/scale", &c->matte.scale);
   r.Num("composite/matte/search", &c->matte.search_jaw_widths);
   r.Num("composite/matte/prior_softness", &c->matte.prior_softness);

@@ -62,6 +62,10 @@ bool BackgroundPlate::ViewInside() const {
 void BackgroundPlate::Begin(const LayerView& view, double time_s) {
   view_ = view;
   now_ = time_s;
+  struct Anchor {  // the view-to-plate map, whatever Begin decides below
+    BackgroundPlate* p;
+    ~Anchor() { p->view_to_plate_ = p->PlateFromView(); }
+  } anchor{this};
   if (anchored_) {
     const double angle = 2.0 * std::acos(std::min(1.0, std::abs((view.R * anchor_.R.conjugate()).w())));
     if (angle * 180.0 / M_PI > options_.reset_angle_deg) {
@@ -100,22 +104,29 @@ void BackgroundPlate::Reproject() {
 }
 
 void BackgroundPlate::Sample(const cv::Rect& roi, cv::Mat* colour, cv::Mat* valid) const {
+  Sample(roi, 1.0, colour, valid);
+}
+
+void BackgroundPlate::Sample(const cv::Rect& roi, double scale, cv::Mat* colour,
+                             cv::Mat* valid) const {
   // (A plate of another type than the images has never been written: it is
   // all unseen, and its colour is not read.)
   const cv::Rect all(0, 0, plate_.cols, plate_.rows);
-  const cv::Matx33d M = RectMap(PlateFromView(), all, 1.0, roi, 1.0);
-  cv::warpPerspective(plate_, *colour, M, roi.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+  const cv::Matx33d M = RectMap(PlateFromView(), all, 1.0, roi, scale);
+  const cv::Size size(static_cast<int>(std::lround(roi.width * scale)),
+                      static_cast<int>(std::lround(roi.height * scale)));
+  cv::warpPerspective(plate_, *colour, M, size, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
                       cv::BORDER_CONSTANT, cv::Scalar::all(0));
   cv::Mat seen;
-  cv::warpPerspective(seen_, seen, M, roi.size(), cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
+  cv::warpPerspective(seen_, seen, M, size, cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
                       cv::BORDER_CONSTANT, cv::Scalar(kNever));
   // Fresh: 1 up to 3/4 of the maximum age, fading to 0 at it.
   const float now = static_cast<float>(now_), max_age = static_cast<float>(options_.max_age_s);
-  valid->create(roi.size(), CV_32F);
-  for (int y = 0; y < roi.height; ++y) {
+  valid->create(size, CV_32F);
+  for (int y = 0; y < size.height; ++y) {
     const float* s = seen.ptr<float>(y);
     float* v = valid->ptr<float>(y);
-    for (int x = 0; x < roi.width; ++x) {
+    for (int x = 0; x < size.width; ++x) {
       const float age = now - s[x];
       v[x] = std::min(1.0f, std::max(0.0f, (max_age - age) / (0.25f * max_age)));
     }
@@ -126,50 +137,35 @@ void BackgroundPlate::Sample(const cv::Rect& roi, cv::Mat* colour, cv::Mat* vali
 }
 
 bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
-                             const cv::Rect& roi, float background_below) {
+                             const cv::Rect& roi, float background_below, int row_step,
+                             int row_phase) {
   if (image_roi.type() != plate_.type()) {
     plate_ = cv::Mat(plate_.size(), image_roi.type(), cv::Scalar::all(0));
     seen_.setTo(cv::Scalar(kNever));
   }
-  const int cn = plate_.channels();
   const cv::Rect all(0, 0, plate_.cols, plate_.rows);
   const Eigen::Matrix3d H = PlateFromView();
   const cv::Rect target = MapRect(H, roi, all);
   if (target.empty()) return true;
-  // This frame's background and matte at each plate pixel of the target.
-  const cv::Matx33d M = RectMap(H.inverse(), roi, 1.0, target, 1.0);
-  cv::Mat image, matte;
-  cv::warpPerspective(image_roi, image, M, target.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
-                      cv::BORDER_CONSTANT, cv::Scalar::all(0));
-  cv::warpPerspective(matte_roi, matte, M, target.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
-                      cv::BORDER_CONSTANT, cv::Scalar(1.0));
-  const float now = static_cast<float>(now_), max_age = static_cast<float>(options_.max_age_s);
-  const float rate = static_cast<float>(options_.update_rate);
-  const int outlier = static_cast<int>(options_.outlier_level);
+  // Each plate pixel of the target looks up the view pixel it shows: the
+  // matte there (nearest), and, where it is the scene, the picture
+  // (bilinear). Every `row_step`-th row, starting at `row_phase`.
+  const Eigen::Matrix3d G = H.inverse();
   double diff = 0.0;
   int compared = 0;
-  for (int y = 0; y < target.height; ++y) {
-    const uchar* in = image.ptr<uchar>(y);
-    const float* m = matte.ptr<float>(y);
-    uchar* p = plate_.ptr<uchar>(y + target.y) + cn * target.x;
-    float* s = seen_.ptr<float>(y + target.y) + target.x;
-    for (int x = 0; x < target.width; ++x) {
-      if (!(m[x] < background_below)) continue;
-      const bool fresh = now - s[x] < max_age;
-      int d = 0;
-      for (int c = cn * x; c < cn * (x + 1); ++c) d += std::abs(in[c] - p[c]);
-      if (fresh) {
-        diff += static_cast<double>(d) / cn;
-        ++compared;
-        // A fresh pixel that disagrees this much is more likely a subject's
-        // edge than the scene: not taken; it expires if the scene changed.
-        if (d > outlier * cn) continue;
+  const int step = std::max(1, row_step), first = target.y + ((row_phase % step) + step) % step;
+  const double w1 = roi.width - 1.0, h1 = roi.height - 1.0;
+  for (int y = first; y < target.y + target.height; y += step) {
+    const Eigen::Vector3d r0 = G * Eigen::Vector3d(target.x, y, 1.0);
+    double X = r0.x(), Y = r0.y(), Z = r0.z();
+    for (int x = 0; x < target.width; ++x, X += G(0, 0), Y += G(1, 0), Z += G(2, 0)) {
+      const double vx = X / Z - roi.x, vy = Y / Z - roi.y;
+      if (!(vx >= 0.0 && vy >= 0.0 && vx <= w1 && vy <= h1)) continue;
+      if (!(matte_roi.at<float>(static_cast<int>(vy + 0.5), static_cast<int>(vx + 0.5)) <
+            background_below)) {
+        continue;
       }
-      const float a = fresh ? rate : 1.0f;
-      for (int c = cn * x; c < cn * (x + 1); ++c) {
-        p[c] = cv::saturate_cast<uchar>(p[c] + a * (in[c] - p[c]));
-      }
-      s[x] = now;
+      UpdatePixel(image_roi, vx, vy, target.x + x, y, &diff, &compared);
     }
   }
   if (compared > 400 && diff / compared > options_.scene_cut_level) {
@@ -180,14 +176,69 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
   return true;
 }
 
-double BackgroundPlate::Coverage() const {
-  int fresh = 0;
-  const float now = static_cast<float>(now_);
-  for (int y = 0; y < seen_.rows; ++y) {
-    const float* s = seen_.ptr<float>(y);
-    for (int x = 0; x < seen_.cols; ++x) fresh += now - s[x] < options_.max_age_s;
+void BackgroundPlate::UpdatePixel(const cv::Mat& image, double vx, double vy, int px, int py,
+                                  double* diff, int* compared) {
+  const int cn = plate_.channels();
+  const int x0 = std::min(static_cast<int>(vx), image.cols - 2);
+  const int y0 = std::min(static_cast<int>(vy), image.rows - 2);
+  const float fx = static_cast<float>(vx - x0), fy = static_cast<float>(vy - y0);
+  const uchar* r0 = image.ptr<uchar>(y0) + cn * x0;
+  const uchar* r1 = image.ptr<uchar>(y0 + 1) + cn * x0;
+  float in[4];
+  for (int c = 0; c < cn; ++c) {
+    in[c] = (1 - fy) * ((1 - fx) * r0[c] + fx * r0[c + cn]) + fy * ((1 - fx) * r1[c] + fx * r1[c + cn]);
   }
-  return static_cast<double>(fresh) / seen_.total();
+  uchar* p = plate_.ptr<uchar>(py) + cn * px;
+  float& seen = seen_.at<float>(py, px);
+  const bool fresh = now_ - seen < options_.max_age_s;
+  float d = 0.0f;
+  for (int c = 0; c < cn; ++c) d += std::abs(in[c] - p[c]);
+  if (fresh) {
+    *diff += d / cn;
+    ++*compared;
+    // A fresh pixel that disagrees this much is more likely a subject's edge
+    // than the scene: not taken; it expires if the scene really changed.
+    if (d > options_.outlier_level * cn) return;
+  }
+  const float a = fresh ? static_cast<float>(options_.update_rate) : 1.0f;
+  for (int c = 0; c < cn; ++c) p[c] = cv::saturate_cast<uchar>(p[c] + a * (in[c] - p[c]));
+  seen = static_cast<float>(now_);
+}
+
+float BackgroundPlate::SampleAt(double x, double y, uchar* colour) const {
+  // The plate pixel the view pixel (x, y) shows, bilinear; fresh only where
+  // all four are.
+  const Eigen::Vector3d q = view_to_plate_ * Eigen::Vector3d(x, y, 1.0);
+  const double px = q.x() / q.z(), py = q.y() / q.z();
+  if (!(px >= 0.0 && py >= 0.0 && px < plate_.cols - 1.0 && py < plate_.rows - 1.0)) return 0.0f;
+  const int x0 = static_cast<int>(px), y0 = static_cast<int>(py);
+  const float* s0 = seen_.ptr<float>(y0) + x0;
+  const float* s1 = seen_.ptr<float>(y0 + 1) + x0;
+  const float oldest = std::min(std::min(s0[0], s0[1]), std::min(s1[0], s1[1]));
+  const float max_age = static_cast<float>(options_.max_age_s);
+  const float v = std::min(1.0f, std::max(0.0f, (max_age - static_cast<float>(now_ - oldest)) /
+                                                     (0.25f * max_age)));
+  if (v <= 0.0f) return 0.0f;
+  const int cn = plate_.channels();
+  const float fx = static_cast<float>(px - x0), fy = static_cast<float>(py - y0);
+  const uchar* r0 = plate_.ptr<uchar>(y0) + cn * x0;
+  const uchar* r1 = plate_.ptr<uchar>(y0 + 1) + cn * x0;
+  for (int c = 0; c < cn; ++c) {
+    colour[c] = cv::saturate_cast<uchar>((1 - fy) * ((1 - fx) * r0[c] + fx * r0[c + cn]) +
+                                         fy * ((1 - fx) * r1[c] + fx * r1[c + cn]));
+  }
+  return v;
+}
+
+double BackgroundPlate::Coverage() const {
+  // On every 4th pixel of every 4th row.
+  int fresh = 0, all = 0;
+  const float now = static_cast<float>(now_);
+  for (int y = 0; y < seen_.rows; y += 4) {
+    const float* s = seen_.ptr<float>(y);
+    for (int x = 0; x < seen_.cols; x += 4, ++all) fresh += now - s[x] < options_.max_age_s;
+  }
+  return all > 0 ? static_cast<double>(fresh) / all : 0.0;
 }
 
 }  // namespace steadiface

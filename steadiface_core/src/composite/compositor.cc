@@ -7,6 +7,12 @@
 namespace steadiface {
 namespace {
 
+// A matte below this is no subject (the guided filter leaves small values
+// everywhere; they would not change an 8-bit pixel).
+constexpr float kNone = 1.0f / 512.0f;
+// A fill that shows through the subject by less than this is not made.
+constexpr float kFillNone = 1.0f / 64.0f;
+
 double MsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
 }
@@ -20,6 +26,9 @@ Status ValidateCompositeOptions(const CompositeOptions& o) {
   if (!s.ok()) return s;
   if (!(o.plate_below >= 0.0 && o.plate_below <= 1.0)) {
     return Status::Error("composite: plate_below must be in [0, 1]");
+  }
+  if (o.plate_row_step < 1 || o.plate_row_step > 8) {
+    return Status::Error("composite: plate_row_step must be in [1, 8]");
   }
   if (o.plate_distance_px < 0 || o.plate_distance_px > 64) {
     return Status::Error("composite: plate_distance_px must be in [0, 64]");
@@ -56,19 +65,14 @@ Status Compositor::Compose(const cv::Mat& subject, const LayerView& subject_view
   if (out->data != background.data) background.copyTo(*out);
   plate_.Begin(background_view, time_s);
   const cv::Size size = background.size();
-  const cv::Rect whole(0, 0, size.width, size.height);
-  const cv::Rect roi_b = matte_.Roi(region, size);
+  const cv::Rect roi = matte_.Roi(region, size);
   report_.plate_restarts = plate_.restarts();
   report_.plate_reprojections = plate_.reprojections();
-  if (roi_b.empty()) {
-    matte_b_.release();
-    matte_s_.release();
-    plate_weight_.release();
-    plate_sample_.release();
-    return Status::Ok();
-  }
-  report_.active = true;
-  report_.background_roi = roi_b;
+  matte_b_.release();
+  matte_s_.release();
+  plate_weight_.release();
+  plate_sample_.release();
+  if (roi.empty()) return Status::Ok();
   auto t0 = std::chrono::steady_clock::now();
   MatteInputs in;
   in.background = background;
@@ -76,39 +80,21 @@ Status Compositor::Compose(const cv::Mat& subject, const LayerView& subject_view
   in.background_view = background_view;
   in.subject_view = subject_view;
   in.region = region;
-  in.roi = roi_b;
-  plate_.Sample(roi_b, &in.plate, &in.plate_valid);
+  in.roi = roi;
+  // The plate at the matte's low resolution.
+  const int s = matte_.scale();
+  const cv::Rect rl = matte_.LowRoi(roi, cv::Size((size.width + s - 1) / s, (size.height + s - 1) / s));
+  const cv::Rect view_rl(rl.x * s, rl.y * s, rl.width * s, rl.height * s);
+  plate_.Sample(view_rl, 1.0 / s, &in.plate, &in.plate_valid);
   report_.plate_ms = MsSince(t0);
   t0 = std::chrono::steady_clock::now();
+  cv::Rect active;
   cv::Mat raw;
-  matte_.Estimate(in, &raw);
-  matte_b_ = raw * region.blend;
-  report_.matte_mean = cv::mean(matte_b_)[0];
-  // The matte in the subject layer's view.
-  const Eigen::Matrix3d H_sb = HomographyBetween(subject_view, background_view);
-  const Eigen::Matrix3d H_bs = HomographyBetween(background_view, subject_view);
-  const cv::Rect roi_s = MapRect(H_sb, roi_b, whole);
-  report_.subject_roi = roi_s;
-  if (!roi_s.empty()) {
-    cv::warpPerspective(matte_b_, matte_s_, RectMap(H_bs, roi_b, 1.0, roi_s, 1.0), roi_s.size(),
-                        cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
-                        cv::Scalar(0));
-  } else {
-    matte_s_.release();
-  }
+  matte_.Estimate(in, &active, &raw);
   report_.matte_ms = MsSince(t0);
+  if (!active.empty()) ComposeActive(subject, subject_view, background_view, region, active, raw, out);
   t0 = std::chrono::steady_clock::now();
-  FillUncovered(subject, in.plate, in.plate_valid, out);
-  plate_sample_ = in.plate;
-  if (!roi_s.empty()) Blend(subject, out);
-  report_.blend_ms = MsSince(t0);
-  // The plate learns this frame's scene, away from the subject's edge.
-  t0 = std::chrono::steady_clock::now();
-  cv::Mat grown;
-  const int g = 2 * options_.plate_distance_px + 1;
-  cv::dilate(raw, grown, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(g, g)));
-  grown.setTo(1.0f, matte_.scene_known() < 0.5f);
-  plate_.Update(background(roi_b), grown, roi_b, static_cast<float>(options_.plate_below));
+  UpdatePlate(background, roi, active, raw);
   report_.plate_ms += MsSince(t0);
   report_.plate_coverage = plate_.Coverage();
   report_.plate_restarts = plate_.restarts();
@@ -116,44 +102,108 @@ Status Compositor::Compose(const cv::Mat& subject, const LayerView& subject_view
   return Status::Ok();
 }
 
-void Compositor::FillUncovered(const cv::Mat& subject, const cv::Mat& plate, const cv::Mat& valid,
-                               cv::Mat* out) {
+void Compositor::ComposeActive(const cv::Mat& subject, const LayerView& subject_view,
+                               const LayerView& background_view, const SubjectRegion& region,
+                               const cv::Rect& active, const cv::Mat& raw, cv::Mat* out) {
+  auto t0 = std::chrono::steady_clock::now();
+  report_.active = true;
+  report_.background_roi = active;
+  matte_b_ = raw;
+  if (region.blend < 1.0) matte_b_ *= region.blend;
+  // The matte in the subject layer's view.
+  const cv::Rect whole(0, 0, out->cols, out->rows);
+  const Eigen::Matrix3d H_sb = HomographyBetween(subject_view, background_view);
+  const Eigen::Matrix3d H_bs = HomographyBetween(background_view, subject_view);
+  const cv::Rect roi_s = MapRect(H_sb, active, whole);
+  report_.subject_roi = roi_s;
+  if (!roi_s.empty()) {
+    cv::warpPerspective(matte_b_, matte_s_, RectMap(H_bs, active, 1.0, roi_s, 1.0), roi_s.size(),
+                        cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                        cv::Scalar(0));
+  }
+  report_.matte_ms += MsSince(t0);
+  t0 = std::chrono::steady_clock::now();
+  FillUncovered(subject, out);
+  if (!roi_s.empty()) Blend(subject, out);
+  report_.blend_ms = MsSince(t0);
+}
+
+void Compositor::UpdatePlate(const cv::Mat& background, const cv::Rect& roi, const cv::Rect& active,
+                             const cv::Mat& raw) {
+  // The plate learns this frame's scene around the subject (what it may
+  // uncover next), where the matte knows the scene to be and away from the
+  // subject's edge.
+  const int s = matte_.scale();
+  const cv::Rect& rl = matte_.low_roi();
+  const cv::Rect view_rl(rl.x * s, rl.y * s, rl.width * s, rl.height * s);
+  const cv::Rect update = view_rl & roi;
+  if (update.empty() || matte_.scene_known_low().empty()) return;
+  cv::Mat known_up, blocked;
+  cv::resize(matte_.scene_known_low(), known_up, view_rl.size(), 0, 0, cv::INTER_NEAREST);
+  blocked = 1.0 - known_up(cv::Rect(update.x - view_rl.x, update.y - view_rl.y, update.width,
+                                    update.height));
+  if (!active.empty()) {
+    const int g = 2 * options_.plate_distance_px + 1;
+    cv::Mat grown;
+    cv::dilate(raw, grown, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(g, g)));
+    const cv::Rect a = active & update;
+    cv::Mat b = blocked(cv::Rect(a.x - update.x, a.y - update.y, a.width, a.height));
+    cv::max(b, grown(cv::Rect(a.x - active.x, a.y - active.y, a.width, a.height)), b);
+  }
+  plate_.Update(background(update), blocked, update, static_cast<float>(options_.plate_below),
+                options_.plate_row_step, frame_++);
+}
+
+void Compositor::FillUncovered(const cv::Mat& subject, cv::Mat* out) {
+  // Where the background layer shows the subject (m_b) and the subject
+  // layer does not (1 - m_s), the plate (freshness v), else the fallback.
   const cv::Rect& rb = report_.background_roi;
   const cv::Rect& rs = report_.subject_roi;
   const int cn = out->channels();
-  plate_weight_.create(rb.size(), CV_32F);
-  double uncovered = 0.0, filled = 0.0;
+  if (keep_plate_) {
+    plate_weight_ = cv::Mat::zeros(rb.size(), CV_32F);
+    plate_sample_ = cv::Mat::zeros(rb.size(), out->type());
+  }
+  uchar scratch[4];
+  double uncovered = 0.0, filled = 0.0, matte_sum = 0.0;
   for (int y = 0; y < rb.height; ++y) {
     const int Y = rb.y + y;
     const float* mb = matte_b_.ptr<float>(y);
-    const float* v = valid.ptr<float>(y);
-    const uchar* P = plate.ptr<uchar>(y);
     const uchar* S = subject.ptr<uchar>(Y) + cn * rb.x;
     uchar* O = out->ptr<uchar>(Y) + cn * rb.x;
+    uchar* P = keep_plate_ ? plate_sample_.ptr<uchar>(y) : nullptr;
     const bool in_s = Y >= rs.y && Y < rs.y + rs.height;
     const float* ms = in_s ? matte_s_.ptr<float>(Y - rs.y) : nullptr;
-    float* w = plate_weight_.ptr<float>(y);
+    float* w = keep_plate_ ? plate_weight_.ptr<float>(y) : nullptr;
     for (int x = 0; x < rb.width; ++x) {
+      const float m = mb[x];
+      matte_sum += m;
+      if (m < kNone) continue;
       const int X = rb.x + x;
       const float m_s = in_s && X >= rs.x && X < rs.x + rs.width ? ms[X - rs.x] : 0.0f;
-      const float m = mb[x];
-      w[x] = m * v[x] * (1.0f - m_s);
-      if (m <= 0.0f) continue;
+      // The subject covers it (Blend draws it), or what would show of the
+      // fill under it is negligible.
+      if (m * (1.0f - m_s) < kFillNone) continue;
+      uchar* p = P != nullptr ? P + cn * x : scratch;
+      const float v = plate_.SampleAt(X, Y, p);
       uncovered += m * (1.0f - m_s);
-      filled += w[x];
-      const float wp = m * v[x], wf = m * (1.0f - v[x]);
-      for (int c = cn * x; c < cn * (x + 1); ++c) {
-        const float b = O[c];
-        O[c] = cv::saturate_cast<uchar>(b + wp * (P[c] - b) + wf * (S[c] - b));
+      filled += m * v * (1.0f - m_s);
+      if (w != nullptr) w[x] = m * v * (1.0f - m_s);
+      const float wp = m * v, wf = m * (1.0f - v);
+      for (int c = 0; c < cn; ++c) {
+        const float b = O[cn * x + c];
+        O[cn * x + c] = cv::saturate_cast<uchar>(b + wp * (p[c] - b) + wf * (S[cn * x + c] - b));
       }
     }
   }
+  report_.matte_mean = matte_sum / std::max(1, rb.area());
   report_.uncovered_px = uncovered;
   report_.plate_share = uncovered > 0.0 ? filled / uncovered : 0.0;
   report_.fallback_share = uncovered > 0.0 ? 1.0 - report_.plate_share : 0.0;
 }
 
 void Compositor::Blend(const cv::Mat& subject, cv::Mat* out) {
+  // out += m_s (S - out), in 1/256 steps; a whole subject pixel is copied.
   const cv::Rect& rs = report_.subject_roi;
   const int cn = out->channels();
   for (int y = 0; y < rs.height; ++y) {
@@ -161,10 +211,13 @@ void Compositor::Blend(const cv::Mat& subject, cv::Mat* out) {
     const uchar* S = subject.ptr<uchar>(rs.y + y) + cn * rs.x;
     uchar* O = out->ptr<uchar>(rs.y + y) + cn * rs.x;
     for (int x = 0; x < rs.width; ++x) {
-      if (m[x] <= 0.0f) continue;
-      for (int c = cn * x; c < cn * (x + 1); ++c) {
-        O[c] = cv::saturate_cast<uchar>(O[c] + m[x] * (S[c] - O[c]));
+      const int w = static_cast<int>(m[x] * 256.0f + 0.5f);
+      if (w <= 0) continue;
+      if (w >= 256) {
+        for (int c = cn * x; c < cn * (x + 1); ++c) O[c] = S[c];
+        continue;
       }
+      for (int c = cn * x; c < cn * (x + 1); ++c) O[c] = static_cast<uchar>(O[c] + ((w * (S[c] - O[c]) + 128) >> 8));
     }
   }
 }

@@ -29,11 +29,12 @@ int Bin(const uchar* px, int cn) {
          px[2] * kLevels / 256;
 }
 
-// The log-odds prior of the landmarks: the region's outline softened, and
-// certain inside the face (the landmarks' own oval).
-float PriorLogOdds(const SubjectRegion& r, const Eigen::Vector2d& p, double softness) {
+// The log-odds prior of the landmarks: the region's outline (at signed
+// distance sd) softened, and certain inside the face (the landmarks' own
+// oval).
+float PriorLogOdds(const SubjectRegion& r, const Eigen::Vector2d& p, double sd, double softness) {
   const double jaw = std::max(1.0, r.jaw_width);
-  float l = Clamp(static_cast<float>(-r.SignedDistance(p) / (softness * jaw)), -3.0f, 3.0f);
+  float l = Clamp(static_cast<float>(-sd / (softness * jaw)), -3.0f, 3.0f);
   const Eigen::Vector2d c = std::isfinite(r.face_centre.x()) ? r.face_centre : r.head_centre;
   const Eigen::Vector2d q((p.x() - c.x()) / (0.42 * jaw),
                           (p.y() - c.y()) / std::max(1.0, 0.55 * r.face_height));
@@ -110,55 +111,120 @@ cv::Rect SubjectMatte::Roi(const SubjectRegion& r, const cv::Size& output) const
   return cv::Rect(ix0, iy0, ix1 - ix0, iy1 - iy0) & cv::Rect(0, 0, output.width, output.height);
 }
 
-void SubjectMatte::Estimate(const MatteInputs& in, cv::Mat* matte) {
+void SubjectMatte::Estimate(const MatteInputs& in, cv::Rect* active, cv::Mat* matte) {
   const int s = options_.scale;
   LowRes low;
   low.s = s;
   const cv::Size small((in.background.cols + s - 1) / s, (in.background.rows + s - 1) / s);
-  cv::Mat bg_small;
+  cv::Mat bg_small, subject_small;
   cv::resize(in.background, bg_small, small, 0, 0, cv::INTER_AREA);
   low.background = Grey(bg_small);
-  cv::resize(Grey(in.subject), low.subject, small, 0, 0, cv::INTER_AREA);
-  low.roi = cv::Rect(in.roi.x / s, in.roi.y / s, (in.roi.width + s - 1) / s,
-                     (in.roi.height + s - 1) / s) & cv::Rect(0, 0, small.width, small.height);
+  cv::resize(in.subject, subject_small, small, 0, 0, cv::INTER_AREA);
+  low.subject = Grey(subject_small);
+  low.roi = LowRoi(in.roi, small);
   low.colour = bg_small(low.roi);
-  if (!in.plate.empty()) {
-    cv::resize(in.plate, low.plate, low.roi.size(), 0, 0, cv::INTER_AREA);
-    cv::resize(in.plate_valid, low.plate_valid, low.roi.size(), 0, 0, cv::INTER_AREA);
-  }
+  low.plate = in.plate;
+  low.plate_valid = in.plate_valid;
   cv::Mat logodds, verified;
   const cv::Mat lm = MotionEvidence(in, low);
   const cv::Mat accumulated = AccumulateMotion(in, low, lm);
   Evidence(in, low, lm, accumulated, &logodds, &verified);
+  Refine(in, low, logodds, active, matte);
+  scene_known_low_ = verified;
+  low_roi_ = low.roi;
+  Remember(in, logodds, low, verified);
+}
+
+cv::Rect SubjectMatte::LowRoi(const cv::Rect& roi, const cv::Size& small) const {
+  const int s = options_.scale;
+  return cv::Rect(roi.x / s, roi.y / s, (roi.width + s - 1) / s, (roi.height + s - 1) / s) &
+         cv::Rect(0, 0, small.width, small.height);
+}
+
+void SubjectMatte::Refine(const MatteInputs& in, const LowRes& low, const cv::Mat& logodds,
+                          cv::Rect* active, cv::Mat* matte) const {
   // Low-resolution matte, refined at the picture's edges (He and Sun's fast
   // guided filter: the linear coefficients at low resolution, applied to the
-  // full-resolution guide).
+  // full-resolution guide) where the subject may be: the low matte's
+  // support, grown by the filter's reach.
+  const int s = low.s;
   cv::Mat p(logodds.size(), CV_32F);
+  int x0 = p.cols, y0 = p.rows, x1 = -1, y1 = -1;
   for (int y = 0; y < p.rows; ++y) {
     const float* l = logodds.ptr<float>(y);
     float* m = p.ptr<float>(y);
-    for (int x = 0; x < p.cols; ++x) m[x] = 1.0f / (1.0f + std::exp(-l[x]));
+    for (int x = 0; x < p.cols; ++x) {
+      m[x] = 1.0f / (1.0f + std::exp(-l[x]));
+      if (m[x] > 0.01f) {
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+    }
   }
-  cv::Mat guide_low;
-  low.background(low.roi).convertTo(guide_low, CV_32F, 1.0 / 255.0);
+  *active = cv::Rect();
+  matte->release();
+  if (x1 < 0) return;
   const int r = std::max(1, options_.edge_radius_px / s);
-  cv::Mat mean_a, mean_b;
+  cv::Mat guide_low, mean_a, mean_b;
+  low.background(low.roi).convertTo(guide_low, CV_32F, 1.0 / 255.0);
   GuidedFilterCoefficients(guide_low, p, r, options_.edge_eps, &mean_a, &mean_b);
-  cv::Mat A, B;
-  const cv::Size up(low.roi.width * s, low.roi.height * s);
-  cv::resize(mean_a, A, up, 0, 0, cv::INTER_LINEAR);
-  cv::resize(mean_b, B, up, 0, 0, cv::INTER_LINEAR);
-  const cv::Rect crop(in.roi.x - low.roi.x * s, in.roi.y - low.roi.y * s, in.roi.width,
-                      in.roi.height);
-  cv::Mat guide;
-  Grey(in.background(in.roi)).convertTo(guide, CV_32F, 1.0 / 255.0);
-  *matte = A(crop).mul(guide) + B(crop);
+  // The active rectangle in low pixels (of the roi), then in output pixels.
+  const cv::Rect low_active =
+      cv::Rect(x0 - 2 * r - 1, y0 - 2 * r - 1, x1 - x0 + 4 * r + 3, y1 - y0 + 4 * r + 3) &
+      cv::Rect(0, 0, p.cols, p.rows);
+  *active = cv::Rect((low.roi.x + low_active.x) * s, (low.roi.y + low_active.y) * s,
+                     low_active.width * s, low_active.height * s) &
+            in.roi;
+  if (active->empty()) return;
+  // Where the coefficient a is small the guide's detail does not show: the
+  // low-resolution output, interpolated. Elsewhere (the edges) a I + b per
+  // pixel, with a and b interpolated.
+  const cv::Mat q_low = mean_a.mul(guide_low) + mean_b;
+  cv::Mat base;
+  const cv::Size up(low_active.width * s, low_active.height * s);
+  cv::resize(q_low(low_active), base, up, 0, 0, cv::INTER_LINEAR);
+  const cv::Rect crop(active->x - (low.roi.x + low_active.x) * s,
+                      active->y - (low.roi.y + low_active.y) * s, active->width, active->height);
+  *matte = base(crop).clone();
+  cv::Mat edge = cv::abs(mean_a) > 0.02;
+  cv::dilate(edge, edge, cv::Mat());
+  RefineEdges(in.background, low.roi, *active, mean_a, mean_b, edge, matte);
   cv::min(*matte, 1.0, *matte);
   cv::max(*matte, 0.0, *matte);
-  cv::Mat known_up;
-  cv::resize(verified, known_up, up, 0, 0, cv::INTER_NEAREST);
-  scene_known_ = known_up(crop).clone();
-  Remember(in, logodds, low, verified);
+}
+
+void SubjectMatte::RefineEdges(const cv::Mat& picture, const cv::Rect& low_roi,
+                               const cv::Rect& active, const cv::Mat& mean_a,
+                               const cv::Mat& mean_b, const cv::Mat& edge, cv::Mat* matte) const {
+  // a I + b at full resolution in the low cells marked `edge`, a and b
+  // interpolated bilinearly between the low pixels' centres.
+  const int s = options_.scale, cn = picture.channels();
+  const float inv = 1.0f / s;
+  for (int y = 0; y < active.height; ++y) {
+    const int Y = active.y + y;
+    const float v = (Y + 0.5f) * inv - 0.5f - low_roi.y;
+    const int v0 = std::max(0, std::min(mean_a.rows - 2, static_cast<int>(std::floor(v))));
+    const float fv = std::min(1.0f, std::max(0.0f, v - v0));
+    const int cell_y = std::max(0, std::min(edge.rows - 1, Y / s - low_roi.y));
+    const uchar* e = edge.ptr<uchar>(cell_y);
+    const uchar* px = picture.ptr<uchar>(Y);
+    float* m = matte->ptr<float>(y);
+    for (int x = 0; x < active.width; ++x) {
+      const int X = active.x + x;
+      if (!e[std::max(0, std::min(edge.cols - 1, X / s - low_roi.x))]) continue;
+      const float u = (X + 0.5f) * inv - 0.5f - low_roi.x;
+      const int u0 = std::max(0, std::min(mean_a.cols - 2, static_cast<int>(std::floor(u))));
+      const float fu = std::min(1.0f, std::max(0.0f, u - u0));
+      auto lerp = [&](const cv::Mat& k) {
+        const float* r0 = k.ptr<float>(v0) + u0;
+        const float* r1 = k.ptr<float>(v0 + 1) + u0;
+        return (1 - fv) * ((1 - fu) * r0[0] + fu * r0[1]) + fv * ((1 - fu) * r1[0] + fu * r1[1]);
+      };
+      const uchar* c = px + cn * X;
+      const float I = cn >= 3 ? (0.114f * c[0] + 0.587f * c[1] + 0.299f * c[2]) / 255.0f
+                              : c[0] / 255.0f;
+      m[x] = lerp(mean_a) * I + lerp(mean_b);
+    }
+  }
 }
 
 cv::Mat SubjectMatte::MotionEvidence(const MatteInputs& in, const LowRes& low) const {
@@ -250,11 +316,12 @@ void SubjectMatte::Evidence(const MatteInputs& in, const LowRes& low, const cv::
     for (int x = 0; x < rl.width; ++x) {
       const Eigen::Vector2d p((rl.x + x + 0.5) * s - 0.5, (rl.y + y + 0.5) * s - 0.5);
       V[x] = 1.0f;
-      if (in.region.SignedDistance(p) > search) {
+      const double sd = in.region.SignedDistance(p);
+      if (sd > search) {
         L[x] = -8.0f;
         continue;
       }
-      const float prior = PriorLogOdds(in.region, p, o.prior_softness);
+      const float prior = PriorLogOdds(in.region, p, sd, o.prior_softness);
       float l = prior;
       if (plate) {
         const uchar* pl = low.plate.ptr<uchar>(y) + cn * x;

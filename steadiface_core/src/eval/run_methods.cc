@@ -125,6 +125,7 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
   if (composite && composite_quality != nullptr) {
     s = CompositeQuality::Create(sim, *p, &quality);
     if (!s.ok()) return s;
+    p->KeepCompositePlateUse(true);
     if (!composite_frames.empty()) {
       quality->DumpFrames(composite_frames, 15);
     }

@@ -349,6 +349,7 @@ Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered
   }
   warper_ = std::move(warper);
   compositor_ = std::move(compositor);
+  if (compositor_ != nullptr) compositor_->KeepPlateUse(keep_plate_use_);
   options_.warp = w;
   region_.reset(new SubjectRegionTracker(layered.region));
   has_last_stamp_ = false;

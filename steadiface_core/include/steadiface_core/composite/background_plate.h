@@ -60,14 +60,21 @@ class BackgroundPlate {
   /// pixel is fresh, fading to 0 over the last quarter of max_age_s, 0 where
   /// never seen).
   void Sample(const cv::Rect& roi, cv::Mat* colour, cv::Mat* valid) const;
+  /// The same at `scale` pictures' pixels per output pixel (< 1: smaller).
+  void Sample(const cv::Rect& roi, double scale, cv::Mat* colour, cv::Mat* valid) const;
+  /// The plate at output pixel (x, y) of the current view, bilinear, into
+  /// `colour` (the images' channels); returns its freshness in [0, 1] (0:
+  /// not seen, expired or outside; then `colour` is not written).
+  float SampleAt(double x, double y, uchar* colour) const;
   /// Takes this frame's background (`image_roi`, 8-bit, 1-4 channels, output rectangle
   /// `roi`) where `matte_roi` (CV_32F, subject coverage) is below
-  /// `background_below`. Returns false (and restarts the plate) on a scene
-  /// cut.
+  /// `background_below`, on every `row_step`-th plate row from `row_phase`
+  /// (a caller alternating the phase spreads the work over frames). Returns
+  /// false (and restarts the plate) on a scene cut.
   bool Update(const cv::Mat& image_roi, const cv::Mat& matte_roi, const cv::Rect& roi,
-              float background_below);
+              float background_below, int row_step = 1, int row_phase = 0);
 
-  /// Fraction of the plate's pixels that are fresh [0-1].
+  /// Fraction of the plate's pixels that are fresh [0-1] (on a 4 px grid).
   double Coverage() const;
   int restarts() const { return restarts_; }
   int reprojections() const { return reprojections_; }
@@ -79,6 +86,10 @@ class BackgroundPlate {
   // Plate pixel <- output pixel of the current view.
   Eigen::Matrix3d PlateFromView() const { return HomographyBetween(anchor_, view_); }
   bool ViewInside() const;
+  // Update's per-pixel step: plate pixel (px, py) takes the picture at
+  // (vx, vy) of `image` (bilinear), unless it is a fresh pixel's outlier.
+  void UpdatePixel(const cv::Mat& image, double vx, double vy, int px, int py, double* diff,
+                   int* compared);
   void Reproject();
 
   const OutputGeometry output_;
@@ -88,6 +99,7 @@ class BackgroundPlate {
   cv::Mat seen_;   // CV_32F
   bool anchored_ = false;
   LayerView anchor_, view_;
+  Eigen::Matrix3d view_to_plate_ = Eigen::Matrix3d::Identity();
   double now_ = 0.0;
   int restarts_ = 0, reprojections_ = 0;
 };

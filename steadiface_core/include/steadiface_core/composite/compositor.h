@@ -26,6 +26,9 @@ struct CompositeOptions {
   /// ... within this distance (a subject's soft edge, hair, is a mix of
   /// subject and scene) [output px].
   int plate_distance_px = 3;
+  /// The plate learns every this-many-th of its rows per frame, in turn
+  /// (1: all every frame) [count].
+  int plate_row_step = 2;
 };
 
 Status ValidateCompositeOptions(const CompositeOptions& options);
@@ -83,22 +86,30 @@ class Compositor {
   const CompositeReport& report() const { return report_; }
   /// The last matte in the background layer's view over
   /// report().background_roi, and moved into the subject layer's view over
-  /// report().subject_roi (CV_32F, [0, 1]); the plate's use over the
-  /// background roi (CV_32F: the plate's weight m_b v (1 - m_s) in the
-  /// output).
+  /// report().subject_roi (CV_32F, [0, 1]).
   const cv::Mat& background_matte() const { return matte_b_; }
   const cv::Mat& subject_matte() const { return matte_s_; }
+  /// With KeepPlateUse(true), over the background roi: the plate's weight in
+  /// the output, m_b v (1 - m_s) (CV_32F), and the plate as this frame's
+  /// background camera saw it where it was looked at (the images' type);
+  /// empty otherwise (for scoring and debugging: they cost memory).
+  void KeepPlateUse(bool keep) { keep_plate_ = keep; }
   const cv::Mat& plate_weight() const { return plate_weight_; }
-  /// The plate as this frame's background camera saw it, over the
-  /// background roi (the images' type).
   const cv::Mat& plate_sample() const { return plate_sample_; }
   const BackgroundPlate& plate() const { return plate_; }
 
  private:
   Compositor(const OutputGeometry& output, const CompositeOptions& options);
+  // Compose's pieces: the subject's matte in both views, the plate's fill and
+  // the blend over the active rectangle (where the matte is); the plate's
+  // update over the matte's roi.
+  void ComposeActive(const cv::Mat& subject, const LayerView& subject_view,
+                     const LayerView& background_view, const SubjectRegion& region,
+                     const cv::Rect& active, const cv::Mat& raw, cv::Mat* out);
+  void UpdatePlate(const cv::Mat& background, const cv::Rect& roi, const cv::Rect& active,
+                   const cv::Mat& raw);
   // Fills the subject's uncovered pixels of `out` (over the background roi).
-  void FillUncovered(const cv::Mat& subject, const cv::Mat& plate, const cv::Mat& valid,
-                     cv::Mat* out);
+  void FillUncovered(const cv::Mat& subject, cv::Mat* out);
   // The subject over `out` (over the subject roi).
   void Blend(const cv::Mat& subject, cv::Mat* out);
 
@@ -108,6 +119,8 @@ class Compositor {
   BackgroundPlate plate_;
   CompositeReport report_;
   cv::Mat matte_b_, matte_s_, plate_weight_, plate_sample_;
+  bool keep_plate_ = false;
+  int frame_ = 0;  // frames composed (the plate's row phase)
 };
 
 }  // namespace steadiface

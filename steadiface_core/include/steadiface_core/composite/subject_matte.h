@@ -58,9 +58,11 @@ struct MatteInputs {
   LayerView background_view, subject_view;
   /// The subject region, in the background layer's output pixels.
   SubjectRegion region;
-  /// The background plate over `roi` as the background layer sees it
-  /// (colour, validity in [0, 1]); empty when there is none.
+  /// The background plate as the background layer sees it, at the matte's
+  /// low resolution over `roi` (SubjectMatte::LowRoi; colour, validity in
+  /// [0, 1]); empty when there is none.
   cv::Mat plate, plate_valid;
+  /// Where the matte may reach (SubjectMatte::Roi) [output px].
   cv::Rect roi;
 };
 
@@ -84,12 +86,18 @@ class SubjectMatte {
   /// The rectangle of the output (background view) that the matte may
   /// cover for `region` (empty without a usable region).
   cv::Rect Roi(const SubjectRegion& region, const cv::Size& output) const;
-  /// The matte over in.roi (CV_32F in [0, 1]).
-  void Estimate(const MatteInputs& in, cv::Mat* matte);
-  /// Where the last Estimate knew the scene to be (CV_32F, 1 or 0, over its
-  /// roi): outside the subject region, or standing still in the background
-  /// layer while moving in the subject layer. Only there may the plate learn.
-  const cv::Mat& scene_known() const { return scene_known_; }
+  /// `roi` at the matte's low resolution (clipped to the low picture `small`).
+  cv::Rect LowRoi(const cv::Rect& roi, const cv::Size& small) const;
+  int scale() const { return options_.scale; }
+  /// The matte (CV_32F in [0, 1]) over *active, the part of in.roi where the
+  /// subject may be (empty: nowhere); zero elsewhere.
+  void Estimate(const MatteInputs& in, cv::Rect* active, cv::Mat* matte);
+  /// Where the last Estimate knew the scene to be (CV_32F, 1 or 0, at low
+  /// resolution over low_roi()): beyond the search, seen standing still in
+  /// the background layer while moving in the subject layer, or confidently
+  /// the scene outside the landmarks' region. Only there may the plate learn.
+  const cv::Mat& scene_known_low() const { return scene_known_low_; }
+  const cv::Rect& low_roi() const { return low_roi_; }
 
  private:
   struct LowRes;  // this frame's low-resolution pictures over the roi
@@ -100,6 +108,12 @@ class SubjectMatte {
   cv::Mat AccumulateMotion(const MatteInputs& in, const LowRes& low, const cv::Mat& lm);
   void Evidence(const MatteInputs& in, const LowRes& low, const cv::Mat& lm,
                 const cv::Mat& accumulated, cv::Mat* logodds, cv::Mat* verified) const;
+  // The log-odds into the refined full-resolution matte over *active.
+  void Refine(const MatteInputs& in, const LowRes& low, const cv::Mat& logodds, cv::Rect* active,
+              cv::Mat* matte) const;
+  void RefineEdges(const cv::Mat& picture, const cv::Rect& low_roi, const cv::Rect& active,
+                   const cv::Mat& mean_a, const cv::Mat& mean_b, const cv::Mat& edge,
+                   cv::Mat* matte) const;
   void Remember(const MatteInputs& in, const cv::Mat& logodds, const LowRes& low,
                 const cv::Mat& verified);
   float ColourLogRatio(const uchar* px, int cn) const;
@@ -116,7 +130,8 @@ class SubjectMatte {
   Eigen::Vector2d previous_head_ = Eigen::Vector2d::Zero();
   // Colour histograms, subject and scene (8 levels per channel).
   std::vector<float> subject_hist_, scene_hist_;
-  cv::Mat scene_known_;
+  cv::Mat scene_known_low_;
+  cv::Rect low_roi_;
   cv::Mat accumulated_;  // motion evidence, subject layer's view, low resolution
 };
 

@@ -175,6 +175,12 @@ class Pipeline {
   const Warper& warper() const { return *warper_; }
   /// The compositor (warp mode composite; else null).
   const Compositor* compositor() const { return compositor_.get(); }
+  /// Composite mode: keep the plate's use per frame (Compositor::KeepPlateUse;
+  /// for scoring and debugging).
+  void KeepCompositePlateUse(bool keep) {
+    keep_plate_use_ = keep;
+    if (compositor_ != nullptr) compositor_->KeepPlateUse(keep);
+  }
   const CameraModel& camera_model() const { return model_; }
   const RowTiming& row_timing() const { return timing_; }
   const PipelineOptions& options() const { return options_; }
@@ -207,6 +213,7 @@ class Pipeline {
   std::unique_ptr<SubjectRegionTracker> region_;  // layered and composite mode
   std::unique_ptr<Compositor> compositor_;       // composite mode
   cv::Mat subject_picture_;                      // composite: the subject layer's
+  bool keep_plate_use_ = false;
   bool has_last_stamp_ = false;
   Time last_stamp_;
   // gyro_video_check/apply_offset: the previous frame's stamp (rate limit).
