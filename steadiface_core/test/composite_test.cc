@@ -12,6 +12,7 @@
 #include "steadiface_core/composite/compositor.h"
 #include "steadiface_core/composite/guided_filter.h"
 #include "steadiface_core/composite/layer_homography.h"
+#include "steadiface_core/warp/debug_overlay.h"
 #include "steadiface_core/warp/output_geometry.h"
 #include "steadiface_core/warp/warper.h"
 #include "test_util.h"
@@ -253,6 +254,43 @@ TEST(CompositorTest, PutsTheSubjectWhereItsLayerHoldsItAndTheSceneWhereItsLayerH
   }
   EXPECT_GT(iou_sum / n, 0.9);
   EXPECT_LT(mae_sum / n, 8.0);
+}
+
+TEST(CompositorTest, TheDebugOverlayDrawsTheMattesOutlineWhereTheSubjectIs) {
+  // A disc subject on a scene, both still: the matte's outline is drawn
+  // around the disc (through an identity mesh), nowhere far from it.
+  const OutputGeometry g = Geometry();
+  const Scene scene(g);
+  const cv::Size size(g.width(), g.height());
+  std::unique_ptr<Compositor> c;
+  ASSERT_TRUE(Compositor::Create(g, CompositeOptions(), &c).ok());
+  const LayerView v = OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero());
+  cv::Mat picture = scene.Render(v, size), out;
+  cv::circle(picture, cv::Point(320, 180), 60, cv::Scalar(40, 90, 200), -1, cv::LINE_AA);
+  for (int i = 0; i < 10; ++i) {
+    ASSERT_TRUE(c->Compose(picture, v, picture, v, Disc(Eigen::Vector2d(320, 180), 60), i / 30.0,
+                           &out).ok());
+  }
+  WarpMesh identity;
+  identity.cols = identity.rows = 2;
+  identity.u = {0.0, size.width - 1.0};
+  identity.v = {0.0, size.height - 1.0};
+  identity.source = {Eigen::Vector2f(0, 0), Eigen::Vector2f(size.width - 1, 0),
+                     Eigen::Vector2f(0, size.height - 1),
+                     Eigen::Vector2f(size.width - 1, size.height - 1)};
+  cv::Mat dbg = cv::Mat::zeros(size, CV_8UC3);
+  DrawCompositeOverlay(identity, *c, &dbg);
+  std::vector<cv::Mat> ch;
+  cv::split(dbg, ch);
+  const cv::Mat magenta = (ch[0] > 200) & (ch[2] > 200) & (ch[1] < 60);
+  ASSERT_GT(cv::countNonZero(magenta), 200);
+  // Every magenta pixel lies within 12 px of the disc's edge.
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      if (!magenta.at<uchar>(y, x)) continue;
+      EXPECT_NEAR(std::hypot(x - 320.0, y - 180.0), 60.0, 12.0) << x << "," << y;
+    }
+  }
 }
 
 TEST(CompositorTest, WithoutASubjectTheOutputIsTheBackgroundLayer) {

@@ -503,6 +503,10 @@ void StabilizerWrapper::PublishDebugImage(const steadiface::PipelineFrame& frame
                                    frame.layered.region,
                                    frame.layered.blend, og.width(), og.height(), &dbg);
   }
+  if (frame.composite.active && pipeline_->compositor() != nullptr) {
+    // The warper's last mesh is the background layer's (rendered second).
+    steadiface::DrawCompositeOverlay(pipeline_->warper().mesh(), *pipeline_->compositor(), &dbg);
+  }
   sink_->PublishDebugImage(
       ToImageMsg(in_header, sensor_msgs::image_encodings::BGR8, dbg));
 }

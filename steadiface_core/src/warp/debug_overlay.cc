@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/composite/compositor.h"
 #include "steadiface_core/warp/warp_geometry.h"
 
 namespace steadiface {
@@ -119,24 +120,91 @@ void DrawDebugOverlay(const cv::Mat& input, const CameraModel& model,
   }
 }
 
+namespace {
+
+// The mesh's source (input px) of an output point (bilinear in its cell).
+cv::Point2f MeshSource(const WarpMesh& mesh, double u, double v) {
+  int i = 0, j = 0;
+  while (i + 2 < mesh.cols && mesh.u[i + 1] < u) ++i;
+  while (j + 2 < mesh.rows && mesh.v[j + 1] < v) ++j;
+  const double a = std::min(1.0, std::max(0.0, (u - mesh.u[i]) / (mesh.u[i + 1] - mesh.u[i])));
+  const double b = std::min(1.0, std::max(0.0, (v - mesh.v[j]) / (mesh.v[j + 1] - mesh.v[j])));
+  auto q = [&](int ii, int jj) { return mesh.source[jj * mesh.cols + ii].cast<double>(); };
+  const Eigen::Vector2d p = (1 - a) * (1 - b) * q(i, j) + a * (1 - b) * q(i + 1, j) +
+                            (1 - a) * b * q(i, j + 1) + a * b * q(i + 1, j + 1);
+  return cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
+}
+
+void TextLine(const std::string& text, int line_from_bottom, cv::Mat* out) {
+  const double s = std::max(1.0, out->cols / 640.0);
+  const int th = static_cast<int>(std::lround(s));
+  const cv::Point at(static_cast<int>(8 * s),
+                     out->rows - static_cast<int>((10 + 18 * line_from_bottom) * s));
+  cv::putText(*out, text, at, cv::FONT_HERSHEY_SIMPLEX, 0.5 * s, cv::Scalar(0, 0, 0), th + 2,
+              cv::LINE_AA);
+  cv::putText(*out, text, at, cv::FONT_HERSHEY_SIMPLEX, 0.5 * s, cv::Scalar(255, 255, 255), th,
+              cv::LINE_AA);
+}
+
+}  // namespace
+
+void DrawCompositeOverlay(const WarpMesh& background_mesh, const Compositor& compositor,
+                          cv::Mat* out) {
+  const CompositeReport& r = compositor.report();
+  const double s = std::max(1.0, out->cols / 640.0);
+  const int th = static_cast<int>(std::lround(s));
+  if (r.active && !compositor.background_matte().empty() && background_mesh.cols >= 2) {
+    // The matte's outline (magenta), traced in the background layer's
+    // output and mapped into the input through its mesh.
+    const cv::Mat inside = compositor.background_matte() >= 0.5;
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(inside, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+    for (const auto& c : contours) {
+      std::vector<cv::Point> poly;
+      for (const auto& p : c) {
+        const cv::Point2f q = MeshSource(background_mesh, p.x + r.background_roi.x,
+                                         p.y + r.background_roi.y);
+        poly.emplace_back(cvRound(q.x), cvRound(q.y));
+      }
+      cv::polylines(*out, poly, true, cv::Scalar(255, 0, 255), th, cv::LINE_AA);
+    }
+  }
+  // The plate's age, top right: green where fresh, fading to black as it
+  // ages, black where never seen.
+  const cv::Mat& seen = compositor.plate().seen();
+  const double now = compositor.plate().now();
+  const double max_age = compositor.plate().options().max_age_s;
+  const int w = std::max(16, out->cols / 4), h = std::max(9, w * seen.rows / std::max(1, seen.cols));
+  cv::Mat age(seen.size(), CV_8UC3, cv::Scalar::all(0));
+  for (int y = 0; y < seen.rows; ++y) {
+    const float* a = seen.ptr<float>(y);
+    cv::Vec3b* o = age.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < seen.cols; ++x) {
+      const double f = 1.0 - (now - a[x]) / max_age;
+      if (f > 0.0) o[x] = cv::Vec3b(0, static_cast<uchar>(255 * std::min(1.0, f)), 0);
+    }
+  }
+  const cv::Rect inset(out->cols - w - 4, 4, w, h);
+  if ((inset & cv::Rect(0, 0, out->cols, out->rows)) == inset) {
+    cv::resize(age, (*out)(inset), inset.size(), 0, 0, cv::INTER_AREA);
+    cv::rectangle(*out, inset, cv::Scalar(255, 255, 255), 1);
+  }
+  char buf[200];
+  std::snprintf(buf, sizeof(buf),
+                "composite matte %.2f  uncovered %.0f px: plate %.0f%% fallback %.0f%%  plate "
+                "fresh %.0f%%  restarts %d",
+                r.matte_mean, r.uncovered_px, 100 * r.plate_share, 100 * r.fallback_share,
+                100 * r.plate_coverage, r.plate_restarts);
+  TextLine(buf, 0, out);
+}
+
 void DrawLayeredOverlay(const WarpMesh& mesh, const SubjectRegion& region,
                         const LayerBlendReport& blend, int output_width, int output_height,
                         cv::Mat* out) {
   if (mesh.cols < 2 || mesh.rows < 2 || output_width < 2 || output_height < 2) return;
   const double s = std::max(1.0, out->cols / 640.0);
   const int th = static_cast<int>(std::lround(s));
-  // The mesh's source of an output point (bilinear in its cell).
-  auto source = [&mesh](double u, double v) {
-    int i = 0, j = 0;
-    while (i + 2 < mesh.cols && mesh.u[i + 1] < u) ++i;
-    while (j + 2 < mesh.rows && mesh.v[j + 1] < v) ++j;
-    const double a = std::min(1.0, std::max(0.0, (u - mesh.u[i]) / (mesh.u[i + 1] - mesh.u[i])));
-    const double b = std::min(1.0, std::max(0.0, (v - mesh.v[j]) / (mesh.v[j + 1] - mesh.v[j])));
-    auto q = [&](int ii, int jj) { return mesh.source[jj * mesh.cols + ii].cast<double>(); };
-    const Eigen::Vector2d p = (1 - a) * (1 - b) * q(i, j) + a * (1 - b) * q(i + 1, j) +
-                              (1 - a) * b * q(i, j + 1) + a * b * q(i + 1, j + 1);
-    return cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
-  };
+  auto source = [&mesh](double u, double v) { return MeshSource(mesh, u, v); };
   if (region.valid && region.blend > 0.0) {
     // Level sets of the region's signed distance on a coarse output grid.
     const int step = std::max(2, output_width / 160);

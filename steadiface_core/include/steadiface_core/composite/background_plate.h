@@ -79,6 +79,9 @@ class BackgroundPlate {
   int restarts() const { return restarts_; }
   int reprojections() const { return reprojections_; }
   const cv::Mat& colour() const { return plate_; }
+  const BackgroundPlateOptions& options() const { return options_; }
+  /// The current frame's time (Begin) [s].
+  double now() const { return now_; }
   /// Last time each pixel was seen [s]; -inf where never.
   const cv::Mat& seen() const { return seen_; }
 

@@ -31,4 +31,15 @@ void DrawLayeredOverlay(const WarpMesh& mesh, const SubjectRegion& region,
                         const LayerBlendReport& blend, int output_width, int output_height,
                         cv::Mat* out);
 
+class Compositor;
+
+/// Composite warp: draws onto the debug image (input coordinates) the
+/// matte's outline (magenta; traced in the background layer's output and
+/// mapped into the input through its mesh), the plate's age as an inset at
+/// the top right (green where fresh, fading to black, black where never
+/// seen), and a text line with the matte, the uncovered pixels and the
+/// plate's and the fallback's shares.
+void DrawCompositeOverlay(const WarpMesh& background_mesh, const Compositor& compositor,
+                          cv::Mat* out);
+
 }  // namespace steadiface
