@@ -22,6 +22,9 @@
 #include <functional>
 #include <memory>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 #include "steadiface_core/common/command_line.h"
 #include "steadiface_core/eval/feasible_offsets.h"
 #include "steadiface_core/eval/ffmpeg_baseline.h"
@@ -184,6 +187,37 @@ int Usage() {
 
 }  // namespace
 
+// --average15 N: writes each method's output frame N (<prefix>_frame.png)
+// and the mean of frames N-7 .. N+7 (<prefix>_average15.png): a steady
+// background or face is sharp in the average, one that swims is blurred.
+class FrameAverager {
+ public:
+  FrameAverager(std::string prefix, int centre) : prefix_(std::move(prefix)), centre_(centre) {}
+  steadiface::Status Add(const cv::Mat& frame) {
+    const int i = index_++;
+    if (i == centre_) cv::imwrite(prefix_ + "_frame.png", frame);
+    if (i < centre_ - 7 || i > centre_ + 7) return steadiface::Status::Ok();
+    cv::Mat f;
+    frame.convertTo(f, CV_32F);
+    if (sum_.empty()) {
+      sum_ = f;
+    } else {
+      sum_ += f;
+    }
+    if (i == centre_ + 7) {
+      cv::Mat mean;
+      sum_.convertTo(mean, CV_8U, 1.0 / 15.0);
+      cv::imwrite(prefix_ + "_average15.png", mean);
+    }
+    return steadiface::Status::Ok();
+  }
+
+ private:
+  std::string prefix_;
+  int centre_ = 0, index_ = 0;
+  cv::Mat sum_;
+};
+
 // One preset's composite figures: a markdown row and a CSV row.
 std::pair<std::string, std::string> CompositeRow(const std::string& preset,
                                                  const steadiface::eval::CompositeQualityScore& q) {
@@ -238,6 +272,7 @@ int main(int argc, char** argv) {
   double feasible_roll = 0.0;    // --feasible-roll MAX [rad]; 0: none
   bool reach_tube = false;       // --reach-tube: write reach_<preset>_<method>.csv
   bool composite_frames = false;  // --composite-frames: composite_<preset>_<frame>.png
+  int average_at = -1;  // --average15 N: <preset>_<method>_frame.png and _average15.png
   steadiface::CommandLine cl;
   cl.String("--data", &data).String("--out", &out_dir);
   cl.Value("--presets", "a comma-separated list",
@@ -257,6 +292,7 @@ int main(int argc, char** argv) {
   cl.Double("--face-core", &blend.face_core_cells).Flag("--reach-tube", &reach_tube);
   cl.Double("--max-offset", &blend.max_offset);
   cl.Flag("--composite-frames", &composite_frames);
+  cl.Int("--average15", &average_at);
   steadiface::CompositeOptions composite;  // warp mode composite
   cl.Double("--matte-softness", &composite.matte.prior_softness);
   cl.Double("--matte-colour", &composite.matte.colour_weight);
@@ -442,12 +478,19 @@ int main(int argc, char** argv) {
         steadiface::eval::VideoScorer* vsp = vs.get();
         std::vector<steadiface::StabilizerFrame> stab_frames;
         steadiface::eval::CompositeQualityScore cq;
+        std::unique_ptr<FrameAverager> avg;
+        if (average_at >= 0 && !video) {
+          avg.reset(new FrameAverager(out_dir + "/" + preset + "_" + name, average_at));
+        }
         if (s.ok()) {
+          FrameAverager* ap = avg.get();
           s = steadiface::eval::RunMethod(
-              *sim, m, po, render || video, card.get(), &stab_frames,
+              *sim, m, po, render || video || ap != nullptr, card.get(), &stab_frames,
               video ? std::function<steadiface::Status(const cv::Mat&)>(
                           [vsp](const cv::Mat& f) { return vsp->Add(f); })
-                    : nullptr,
+              : ap != nullptr ? std::function<steadiface::Status(const cv::Mat&)>(
+                                    [ap](const cv::Mat& f) { return ap->Add(f); })
+                              : nullptr,
               m == Method::kSteadifaceComposite && !video ? &cq : nullptr,
               composite_frames ? out_dir + "/composite_" + preset : std::string());
         }
