@@ -154,7 +154,9 @@ void SubjectMatte::Refine(const MatteInputs& in, const LowRes& low, const cv::Ma
     const float* l = logodds.ptr<float>(y);
     float* m = p.ptr<float>(y);
     for (int x = 0; x < p.cols; ++x) {
-      m[x] = 1.0f / (1.0f + std::exp(-l[x]));
+      // Confident pixels are exactly 0 or 1, so the filter's coefficient a
+      // vanishes away from the edges (and the per-pixel refinement with it).
+      m[x] = l[x] >= 4.0f ? 1.0f : l[x] <= -4.0f ? 0.0f : 1.0f / (1.0f + std::exp(-l[x]));
       if (m[x] > 0.01f) {
         x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
       }
@@ -196,33 +198,39 @@ void SubjectMatte::RefineEdges(const cv::Mat& picture, const cv::Rect& low_roi,
                                const cv::Rect& active, const cv::Mat& mean_a,
                                const cv::Mat& mean_b, const cv::Mat& edge, cv::Mat* matte) const {
   // a I + b at full resolution in the low cells marked `edge`, a and b
-  // interpolated bilinearly between the low pixels' centres.
+  // interpolated bilinearly between the low pixels' centres; other cells
+  // keep the interpolated low-resolution output.
   const int s = options_.scale, cn = picture.channels();
   const float inv = 1.0f / s;
-  for (int y = 0; y < active.height; ++y) {
-    const int Y = active.y + y;
-    const float v = (Y + 0.5f) * inv - 0.5f - low_roi.y;
-    const int v0 = std::max(0, std::min(mean_a.rows - 2, static_cast<int>(std::floor(v))));
-    const float fv = std::min(1.0f, std::max(0.0f, v - v0));
-    const int cell_y = std::max(0, std::min(edge.rows - 1, Y / s - low_roi.y));
-    const uchar* e = edge.ptr<uchar>(cell_y);
-    const uchar* px = picture.ptr<uchar>(Y);
-    float* m = matte->ptr<float>(y);
-    for (int x = 0; x < active.width; ++x) {
-      const int X = active.x + x;
-      if (!e[std::max(0, std::min(edge.cols - 1, X / s - low_roi.x))]) continue;
-      const float u = (X + 0.5f) * inv - 0.5f - low_roi.x;
-      const int u0 = std::max(0, std::min(mean_a.cols - 2, static_cast<int>(std::floor(u))));
-      const float fu = std::min(1.0f, std::max(0.0f, u - u0));
-      auto lerp = [&](const cv::Mat& k) {
-        const float* r0 = k.ptr<float>(v0) + u0;
-        const float* r1 = k.ptr<float>(v0 + 1) + u0;
-        return (1 - fv) * ((1 - fu) * r0[0] + fu * r0[1]) + fv * ((1 - fu) * r1[0] + fu * r1[1]);
-      };
-      const uchar* c = px + cn * X;
-      const float I = cn >= 3 ? (0.114f * c[0] + 0.587f * c[1] + 0.299f * c[2]) / 255.0f
-                              : c[0] / 255.0f;
-      m[x] = lerp(mean_a) * I + lerp(mean_b);
+  auto lerp = [](const cv::Mat& k, int u0, int v0, float fu, float fv) {
+    const float* r0 = k.ptr<float>(v0) + u0;
+    const float* r1 = k.ptr<float>(v0 + 1) + u0;
+    return (1 - fv) * ((1 - fu) * r0[0] + fu * r0[1]) + fv * ((1 - fu) * r1[0] + fu * r1[1]);
+  };
+  for (int cy = 0; cy < edge.rows; ++cy) {
+    const uchar* e = edge.ptr<uchar>(cy);
+    const int Y0 = std::max(active.y, (low_roi.y + cy) * s);
+    const int Y1 = std::min(active.y + active.height, (low_roi.y + cy + 1) * s);
+    for (int cx = 0; cx < edge.cols; ++cx) {
+      if (!e[cx]) continue;
+      const int X0 = std::max(active.x, (low_roi.x + cx) * s);
+      const int X1 = std::min(active.x + active.width, (low_roi.x + cx + 1) * s);
+      for (int Y = Y0; Y < Y1; ++Y) {
+        const float v = (Y + 0.5f) * inv - 0.5f - low_roi.y;
+        const int v0 = std::max(0, std::min(mean_a.rows - 2, static_cast<int>(std::floor(v))));
+        const float fv = std::min(1.0f, std::max(0.0f, v - v0));
+        const uchar* px = picture.ptr<uchar>(Y);
+        float* m = matte->ptr<float>(Y - active.y) - active.x;
+        for (int X = X0; X < X1; ++X) {
+          const float u = (X + 0.5f) * inv - 0.5f - low_roi.x;
+          const int u0 = std::max(0, std::min(mean_a.cols - 2, static_cast<int>(std::floor(u))));
+          const float fu = std::min(1.0f, std::max(0.0f, u - u0));
+          const uchar* c = px + cn * X;
+          const float I = cn >= 3 ? (0.114f * c[0] + 0.587f * c[1] + 0.299f * c[2]) / 255.0f
+                                  : c[0] / 255.0f;
+          m[X] = lerp(mean_a, u0, v0, fu, fv) * I + lerp(mean_b, u0, v0, fu, fv);
+        }
+      }
     }
   }
 }
