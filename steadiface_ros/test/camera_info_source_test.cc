@@ -247,6 +247,16 @@ TEST(ExampleOverlaysTest, LayeredSwitchesOnlyTheWarpMode) {
                                        l.po.warp));
 }
 
+TEST(ExampleOverlaysTest, CompositeSwitchesOnlyTheWarpMode) {
+  const Loaded c = LoadExample("composite.yaml");
+  const Loaded d = LoadExample("../default.yaml");
+  EXPECT_EQ(c.po.warp.mode, steadiface::WarpMode::kComposite);
+  EXPECT_TRUE(steadiface::SameLayering(steadiface::WarpMode::kComposite, d.po.warp.layered,
+                                       c.po.warp));
+  EXPECT_EQ(c.po.composite.matte.scale, d.po.composite.matte.scale);
+  EXPECT_EQ(c.po.composite.plate.max_age_s, d.po.composite.plate.max_age_s);
+}
+
 TEST(ExampleOverlaysTest, PhoneFrontCameraIsAHalfTurnAboutTheOpticalAxis) {
   const Loaded l = LoadExample("phone.yaml");
   EXPECT_FALSE(l.wo.imu_extrinsics_from_tf);

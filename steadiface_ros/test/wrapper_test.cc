@@ -223,7 +223,8 @@ TEST(WrapperTest, SinkWithoutImagesGetsTheSameInfosAndStates) {
 // one-stage wrapper; each frame is published by the next one or by the
 // hold / flush, never lost; in layered mode too.
 TEST(WrapperTest, PipelinedPublishesTheSameFramesInOrder) {
-  for (steadiface::WarpMode mode : {steadiface::WarpMode::kGlobal, steadiface::WarpMode::kLayered}) {
+  for (steadiface::WarpMode mode : {steadiface::WarpMode::kGlobal, steadiface::WarpMode::kLayered,
+                                    steadiface::WarpMode::kComposite}) {
     steadiface::PipelineOptions po = Options();
     po.warp.mode = mode;
     Sink a, b;
@@ -353,6 +354,54 @@ TEST(WrapperTest, LayeredModePublishesBothLayersAndSwitchesBackToGlobal) {
   EXPECT_EQ(sink.states.back().warp_mode, "global");
   EXPECT_EQ(w.pipeline_options().warp.mode, steadiface::WarpMode::kGlobal);
   EXPECT_EQ(sink.errors.count("reconfigure"), 0u);
+}
+
+// warp/mode composite, switched on at run time from global: the mode and
+// the composite's figures in `state` (finite, in range), camera_info for
+// the background layer, the debug image with the matte; the face's pixels
+// where the subject layer holds them.
+TEST(WrapperTest, CompositeModeSwitchedOnAtRunTimePublishesItsState) {
+  struct DebugSink : public Sink {
+    std::vector<sensor_msgs::ImagePtr> debug;
+    bool WantsDebugImage() const override { return true; }
+    void PublishDebugImage(const sensor_msgs::ImagePtr& i) override { debug.push_back(i); }
+  };
+  DebugSink sink;
+  steadiface::PipelineOptions po = Options();
+  po.landmark_source = steadiface::LandmarkSource::kDlib;  // the matte needs a face
+  StabilizerWrapper w(po, WrapperOptions(), &sink);
+  const int n = static_cast<int>(TestStream().images.size());
+  Feed(&w, TestStream(), 0, n / 4);
+  EXPECT_EQ(sink.states.back().warp_mode, "global");
+  w.RequestLayering(steadiface::WarpMode::kComposite, po.warp.layered);
+  Feed(&w, TestStream(), n / 4, n);
+  ASSERT_EQ(sink.states.size(), static_cast<size_t>(n));
+  EXPECT_EQ(w.pipeline_options().warp.mode, steadiface::WarpMode::kComposite);
+  Sink gyro_sink;
+  steadiface::PipelineOptions go = Options();
+  go.stabilizer.gyro_only = true;
+  go.landmark_source = steadiface::LandmarkSource::kNone;
+  StabilizerWrapper gyro(go, WrapperOptions(), &gyro_sink);
+  Feed(&gyro, TestStream());
+  bool matted = false;
+  for (int i = n / 4; i < n; ++i) {
+    const auto& st = sink.states[i];
+    EXPECT_EQ(st.warp_mode, "composite");
+    ASSERT_TRUE(st.has_background_layer);
+    EXPECT_GE(st.matte_mean, 0.0);
+    EXPECT_LE(st.matte_mean, 1.0);
+    EXPECT_GE(st.plate_share, 0.0);
+    EXPECT_LE(st.plate_share + st.fallback_share, 1.0 + 1e-9);
+    EXPECT_GE(st.plate_coverage, 0.0);
+    EXPECT_LE(st.plate_coverage, 1.0);
+    matted = matted || st.matte_mean > 0.05;
+    EXPECT_EQ(sink.infos[i]->K[2], gyro_sink.infos[i]->K[2]);
+    EXPECT_EQ(sink.images[i]->width, TestStream().images[0]->width);
+  }
+  EXPECT_TRUE(matted);  // the face was found and cut out
+  ASSERT_FALSE(sink.debug.empty());
+  EXPECT_EQ(sink.errors.count("reconfigure"), 0u);
+  ExpectAllFinite(sink);
 }
 
 // Latency parts in `state` on the sink's clock: image arrival, waiting for
