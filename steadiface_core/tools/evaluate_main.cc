@@ -230,20 +230,24 @@ std::pair<std::string, std::string> CompositeRow(const std::string& preset,
   std::ostringstream md, csv;
   md << "| " << preset << " | " << q.frames << " | " << f(q.matte_iou_mean, "%.3f") << " | "
      << f(q.matte_iou_min, "%.3f") << " (" << q.matte_iou_min_frame << ") | "
+     << f(q.matte_iou_min_settled, "%.3f") << " (" << q.matte_iou_min_settled_frame << ") | "
      << f(q.plate_mae, "%.2f") << " (" << f(q.ideal_plate_mae, "%.2f") << ") | "
      << f(q.plate_pixels, "%.0f") << " | "
      << f(q.fallback_share, "%.3f") << " | " << f(q.uncovered_mae, "%.2f") << " ("
      << f(q.uncovered_pixels, "%.0f") << ") | " << f(q.matte_change, "%.4f") << " | "
      << f(q.truth_change, "%.4f") << " | " << f(q.edge_error_px, "%.2f") << " | "
-     << f(q.edge_max_step_px, "%.2f") << " |\n";
+     << f(q.edge_max_step_px, "%.2f") << " | " << f(q.mog2_iou_mean, "%.3f") << " | "
+     << f(q.knn_iou_mean, "%.3f") << " |\n";
   csv << preset << "," << q.frames << "," << f(q.matte_iou_mean, "%.4f") << ","
       << f(q.matte_iou_min, "%.4f") << "," << q.matte_iou_min_frame << ","
+      << f(q.matte_iou_min_settled, "%.4f") << "," << q.matte_iou_min_settled_frame << ","
       << f(q.plate_mae, "%.3f") << "," << f(q.ideal_plate_mae, "%.3f") << ","
       << f(q.plate_pixels, "%.0f") << ","
       << f(q.fallback_share, "%.4f") << "," << f(q.uncovered_mae, "%.3f") << ","
       << f(q.uncovered_pixels, "%.0f") << "," << f(q.matte_change, "%.5f") << ","
       << f(q.truth_change, "%.5f") << "," << f(q.edge_error_px, "%.3f") << ","
-      << f(q.edge_max_step_px, "%.3f") << "\n";
+      << f(q.edge_max_step_px, "%.3f") << "," << f(q.mog2_iou_mean, "%.4f") << ","
+      << f(q.knn_iou_mean, "%.4f") << "\n";
   return {md.str(), csv.str()};
 }
 
@@ -617,13 +621,16 @@ int main(int argc, char** argv) {
   json << "\n  ]\n}\n";
   if (!composite_rows.empty()) {
     std::ofstream csv(out_dir + "/composite_quality.csv");
-    std::cout << "\n| preset | frames | matte IoU mean | matte IoU min (frame) | plate MAE grey |"
+    std::cout << "\n| preset | frames | matte IoU mean | matte IoU min (frame) |"
+                 " min after 0.5 s (frame) | plate MAE grey (ideal plate) |"
                  " plate px | fallback share | uncovered MAE grey (px) | matte change | truth change |"
-                 " edge error px | edge max step px |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    csv << "preset,frames,matte_iou_mean,matte_iou_min,matte_iou_min_frame,plate_mae,"
+                 " edge error px | edge max step px | MOG2 IoU | KNN IoU |\n"
+                 "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    csv << "preset,frames,matte_iou_mean,matte_iou_min,matte_iou_min_frame,matte_iou_min_settled,"
+           "matte_iou_min_settled_frame,plate_mae,"
            "ideal_plate_mae,plate_px,"
            "fallback_share,uncovered_mae,uncovered_px,matte_change,truth_change,edge_error_px,"
-           "edge_max_step_px\n";
+           "edge_max_step_px,mog2_iou_mean,knn_iou_mean\n";
     for (const auto& r : composite_rows) {
       std::cout << r.first;
       csv << r.second;

@@ -7,6 +7,7 @@
 
 #include "steadiface_core/composite/layer_homography.h"
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/background_segm.hpp>
 
 namespace steadiface {
 namespace eval {
@@ -44,6 +45,18 @@ void AddError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& used, double* e
   *pixels += n;
 }
 
+// The IoU of two masks outside the band `k` draws around the true outline;
+// NaN when the truth has too little area there.
+double BandIou(const cv::Mat& T, const cv::Mat& E, const cv::Mat& k) {
+  cv::Mat grown, shrunk;
+  cv::dilate(T, grown, k);
+  cv::erode(T, shrunk, k);
+  const cv::Mat scored = ~(grown & ~shrunk);
+  if (cv::countNonZero(T & scored) < 200) return NAN;
+  const double uni = cv::countNonZero((T | E) & scored);
+  return uni > 0 ? cv::countNonZero(T & E & scored) / uni : 1.0;
+}
+
 }  // namespace
 
 Status CompositeQuality::Create(const sim::Simulator& sim, const Pipeline& pipeline,
@@ -62,7 +75,9 @@ Status CompositeQuality::Create(const sim::Simulator& sim, const Pipeline& pipel
 }
 
 
-Status CompositeQuality::Add(int index, const Pipeline& pipeline, const PipelineFrame& f) {
+
+Status CompositeQuality::Add(int index, const Pipeline& pipeline, const PipelineFrame& f,
+                             const cv::Mat& input) {
   const Compositor* c = pipeline.compositor();
   if (c == nullptr || f.output.empty()) return Status::Ok();
   cv::Mat scene, alpha, truth8, scene_out;
@@ -88,6 +103,12 @@ Status CompositeQuality::Add(int index, const Pipeline& pipeline, const Pipeline
     c->background_matte().copyTo(matte(r.background_roi));
   }
   AddMatte(index, truth, matte);
+  if (!input.empty()) {
+    cv::Mat picture;
+    s = warper_->Warp(input, R_b, t_b, f.stabilizer.rows, &picture);
+    if (!s.ok()) return s;
+    AddSubtractors(truth, picture);
+  }
   ideal_plate_->Begin(OutputView(warper_->output_geometry(), R_b, t_b),
                       ToSeconds(sim_.Truth(index).stamp));
   AddPlate(*c, r, truth, scene_out);
@@ -125,6 +146,23 @@ void CompositeQuality::AddMatte(int index, const cv::Mat& truth, const cv::Mat& 
   cv::morphologyEx(E, edge_e, cv::MORPH_GRADIENT, cv::Mat());
   cv::distanceTransform(~edge_t, dist, cv::DIST_L2, 3);
   edge_.push_back(cv::countNonZero(edge_e) > 0 ? cv::mean(dist, edge_e)[0] : NAN);
+}
+
+void CompositeQuality::AddSubtractors(const cv::Mat& truth, const cv::Mat& picture) {
+  if (mog2_.empty()) {
+    mog2_ = cv::createBackgroundSubtractorMOG2(500, 16.0, false);
+    knn_ = cv::createBackgroundSubtractorKNN(500, 400.0, false);
+  }
+  const cv::Mat T = truth >= 0.5;
+  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT,
+                                              cv::Size(2 * kEdgeBandPx + 1, 2 * kEdgeBandPx + 1));
+  cv::Mat fg;
+  mog2_->apply(picture, fg);
+  const double m = BandIou(T, fg > 127, k);
+  knn_->apply(picture, fg);
+  const double n = BandIou(T, fg > 127, k);
+  if (std::isfinite(m)) mog2_iou_.push_back(m);
+  if (std::isfinite(n)) knn_iou_.push_back(n);
 }
 
 void CompositeQuality::AddPlate(const Compositor& c, const CompositeReport& r,
@@ -204,6 +242,14 @@ CompositeQualityScore CompositeQuality::Compute() const {
       }
     }
     q.matte_iou_mean = sum / iou_.size();
+    const int settled = static_cast<int>(std::lround(0.5 * sim_.options().fps));
+    for (size_t i = 0; i < iou_.size(); ++i) {
+      if (iou_frames_[i] < settled) continue;
+      if (!(iou_[i] >= q.matte_iou_min_settled)) {
+        q.matte_iou_min_settled = iou_[i];
+        q.matte_iou_min_settled_frame = iou_frames_[i];
+      }
+    }
     double e = 0.0, step = 0.0;
     int n = 0;
     for (size_t i = 0; i < edge_.size(); ++i) {
@@ -215,6 +261,13 @@ CompositeQualityScore CompositeQuality::Compute() const {
     if (n > 0) q.edge_error_px = e / n;
     q.edge_max_step_px = step;
   }
+  auto mean = [](const std::vector<double>& v) {
+    double sum = 0.0;
+    for (double x : v) sum += x;
+    return v.empty() ? NAN : sum / v.size();
+  };
+  q.mog2_iou_mean = mean(mog2_iou_);
+  q.knn_iou_mean = mean(knn_iou_);
   if (plate_pixels_ > 0.0) q.plate_mae = plate_error_ / plate_pixels_;
   q.plate_pixels = plate_pixels_;
   if (ideal_pixels_ > 0.0) q.ideal_plate_mae = ideal_error_ / ideal_pixels_;

@@ -148,7 +148,7 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
     if (!s.ok()) return Status::Error("frame " + std::to_string(i) + ": " + s.message());
     card->Add(i, MakeFrameWarp(out, *p, render));
     if (quality != nullptr) {
-      s = quality->Add(i, *p, out);
+      s = quality->Add(i, *p, out, frame);
       if (!s.ok()) return s;
     }
     if (render && on_output) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <opencv2/video/background_segm.hpp>
 
 #include "steadiface_core/common/status.h"
 #include "steadiface_core/composite/background_plate.h"
@@ -24,6 +25,10 @@ struct CompositeQualityScore {
   /// the true outline: mean and worst frame.
   double matte_iou_mean = NAN, matte_iou_min = NAN;
   int matte_iou_min_frame = -1;
+  /// The worst frame after the first half second (the matte's evidence
+  /// needs motion, a plate and colours to build up), and where.
+  double matte_iou_min_settled = NAN;
+  int matte_iou_min_settled_frame = -1;
   /// Mean absolute error of the plate against the true scene behind the
   /// subject, where the plate filled the output (weight >= 0.5) [grey
   /// levels, mean over channels]; the pixels it was measured on.
@@ -46,6 +51,11 @@ struct CompositeQualityScore {
   /// The matte's mean per-frame change over the pixels it covers on either
   /// frame [0-1], and the true subject's for comparison.
   double matte_change = NAN, truth_change = NAN;
+  /// OpenCV's background subtractors on the background layer's picture (the
+  /// scene stands still there, so what moves is the subject): their
+  /// foreground's IoU with the true subject, as the matte's, mean over the
+  /// same frames (the library alternative to the matte's evidence).
+  double mog2_iou_mean = NAN, knn_iou_mean = NAN;
   /// The matte's outline against the truth's: the mean distance of its edge
   /// pixels from the true outline [px], mean over frames, and the largest
   /// per-frame step of that distance [px].
@@ -59,8 +69,10 @@ class CompositeQuality {
  public:
   static Status Create(const sim::Simulator& sim, const Pipeline& pipeline,
                        std::unique_ptr<CompositeQuality>* out);
-  /// Frame `index` after `pipeline` processed it into `frame`.
-  Status Add(int index, const Pipeline& pipeline, const PipelineFrame& frame);
+  /// Frame `index` (the rendered `input`) after `pipeline` processed it
+  /// into `frame`.
+  Status Add(int index, const Pipeline& pipeline, const PipelineFrame& frame,
+             const cv::Mat& input);
   CompositeQualityScore Compute() const;
   /// Writes every `every`-th frame to `<prefix>_<frame>.png`: the output,
   /// the matte (red where it misses the true subject, blue where it covers
@@ -79,6 +91,8 @@ class CompositeQuality {
   // Add's pieces: the matte's IoU and outline; the plate's and the ideal
   // plate's errors; the debug picture.
   void AddMatte(int index, const cv::Mat& truth, const cv::Mat& matte);
+  // The subtractors' foreground on the background layer's picture.
+  void AddSubtractors(const cv::Mat& truth, const cv::Mat& background_picture);
   void AddPlate(const Compositor& c, const CompositeReport& r, const cv::Mat& truth,
                 const cv::Mat& scene_out);
   void Dump(int index, const Compositor& c, const PipelineFrame& f, const cv::Mat& truth,
@@ -89,7 +103,8 @@ class CompositeQuality {
   int plate_distance_px_ = 3;
   float plate_below_ = 0.1f;
   double ideal_error_ = 0.0, ideal_pixels_ = 0.0;
-  std::vector<double> iou_, edge_;
+  std::vector<double> iou_, edge_, mog2_iou_, knn_iou_;
+  cv::Ptr<cv::BackgroundSubtractor> mog2_, knn_;
   std::vector<int> iou_frames_;
   double plate_error_ = 0.0, plate_pixels_ = 0.0;
   double uncovered_error_ = 0.0, uncovered_pixels_ = 0.0;
