@@ -31,7 +31,7 @@ bool Active(double t, double start, double end) {
 const std::vector<std::string>& PresetNames() {
   static const std::vector<std::string> names = {
       "still", "walk", "pan", "run", "occlusion", "two_faces", "turn_away", "vlog", "shake",
-      "drift", "walk_across", "bob"};
+      "drift", "walk_across", "bob", "hair", "passer_by"};
   return names;
 }
 
@@ -131,6 +131,19 @@ bool ApplySubjectPreset(const std::string& name, SimulatorOptions* o) {
     o->head.distance_m = 0.6;
     o->head.bob_amplitude_m = 0.057;
     o->head.sway_amplitude_m = 0.02;
+  } else if (name == "hair") {
+    // vlog, with hair strands at the head's top edge.
+    Walking(o);
+    o->render_torso = true;
+    o->head.distance_m = 0.7;
+    o->hair_edge = true;
+  } else if (name == "passer_by") {
+    // A walking selfie with neck and shoulders; a person walks across the
+    // view 2.5 m away, behind the subject, in the middle of the sequence.
+    Walking(o);
+    o->render_torso = true;
+    o->passer_by_start_s = 0.15 * o->duration_s;
+    o->passer_by_end_s = 0.85 * o->duration_s;
   } else if (name == "walk_across") {
     // The subject walks across the view, 0.9 m away, from 0.35 m left of
     // the centre to 0.35 m right of it over the sequence.
@@ -242,8 +255,10 @@ Status Simulator::Init() {
     }
     return P;
   };
+  if (o.hair_edge) MakeHair();
   MakeTorso();
   MakeSecondFaceAndOccluder(photo, m_per_px);
+  MakePasserBy();
   if (o.use_real_gyro) {
     const Status st = LoadRealGyro();
     if (!st.ok()) return st;
@@ -287,6 +302,55 @@ void Simulator::MakeTorso() {
     T.R = Orbit(Pose(), t).R;
     T.p = centre + T.R * Eigen::Vector3d(0.0, 0.08, options_.torso_depth_m);
     return T;
+  };
+}
+
+void Simulator::MakeHair() {
+  // In the upper half, the outline (unit ellipse distance d) becomes strands:
+  // each column's hair reaches d_max in [0.86, 1], with a soft tip, the
+  // strands semi-transparent between them, in a hair colour.
+  cv::Mat& t = face_.bgra;
+  const double cx = 0.5 * (t.cols - 1), cy = 0.5 * (t.rows - 1);
+  const double ax = 0.5 * t.cols, ay = 0.5 * t.rows;
+  for (int y = 0; y < t.rows && y < cy; ++y) {
+    cv::Vec4b* row = t.ptr<cv::Vec4b>(y);
+    for (int x = 0; x < t.cols; ++x) {
+      const double d = std::hypot((x - cx) / ax, (y - cy) / ay);
+      if (d < 0.8 || d > 1.0) continue;
+      const double reach = 0.95 + 0.03 * std::sin(1.3 * x + 2.0 * std::sin(0.21 * x)) +
+                           0.02 * std::sin(3.1 * x);
+      const double strand = 0.6 + 0.4 * std::abs(std::sin(2.3 * x + std::sin(0.5 * y)));
+      const double a = std::min(1.0, std::max(0.0, (reach - d) / 0.03)) * (d > 0.86 ? strand : 1.0);
+      const double hair = std::min(1.0, (d - 0.8) / 0.06);
+      for (int c = 0; c < 3; ++c) {
+        const double h = c == 0 ? 40 : c == 1 ? 70 : 105;  // BGR, brown
+        row[x][c] = static_cast<uchar>(std::lround(row[x][c] + hair * (h - row[x][c])));
+      }
+      row[x][3] = static_cast<uchar>(std::lround(255.0 * a));
+    }
+  }
+}
+
+void Simulator::MakePasserBy() {
+  // A person 1.7 m tall, 0.5 m wide (a head on a coat), 2.5 m from the
+  // camera's start, walking 2.4 m across behind the subject.
+  const double m = 0.01;
+  const int w = 50, h = 170;
+  passer_by_.bgra = cv::Mat(h, w, CV_8UC4, cv::Scalar::all(0));
+  cv::ellipse(passer_by_.bgra, cv::Point(25, 12), cv::Size(10, 12), 0, 0, 360,
+              cv::Scalar(90, 120, 170, 255), -1, cv::LINE_AA);
+  cv::rectangle(passer_by_.bgra, cv::Rect(3, 26, 44, 144), cv::Scalar(40, 40, 160, 255), -1);
+  for (int y = 40; y < h; y += 12) {
+    cv::line(passer_by_.bgra, cv::Point(3, y), cv::Point(46, y), cv::Scalar(60, 150, 220, 255), 2);
+  }
+  passer_by_.metres_per_px = m;
+  passer_by_.anchor_px = Eigen::Vector2d(25, 60);
+  passer_by_.pose = [this](double t) {
+    const SimulatorOptions& so = options_;
+    const double s = Ramp(t, so.passer_by_start_s, so.passer_by_end_s);
+    Pose P;
+    P.p = Eigen::Vector3d(-1.2 + 2.4 * s, 0.1, 2.5);
+    return P;
   };
 }
 
@@ -485,6 +549,9 @@ void Simulator::RenderFrame(int i, bool with_subject, cv::Mat* bgr) const {
   const Time stamp = Stamp(i);
   const double t = ToSeconds(stamp);
   std::vector<const Billboard*> boards;
+  if (Active(t, options_.passer_by_start_s, options_.passer_by_end_s)) {
+    boards.push_back(&passer_by_);
+  }
   if (Active(t, options_.second_face_start_s, -1)) boards.push_back(&second_face_);
   if (with_subject) {
     for (const Billboard* b : SubjectBoards()) boards.push_back(b);

@@ -78,6 +78,14 @@ struct SimulatorOptions {
   double torso_width_m = 0.42;
   /// Face width on the billboard [m].
   double face_width_m = 0.15;
+  /// Hair at the head's top edge: the upper part of the face billboard's
+  /// outline becomes strands of varying length, semi-transparent between
+  /// them (a soft, ragged edge like real hair).
+  bool hair_edge = false;
+  /// A passer-by (a person 2.5 m away, walking across the view behind the
+  /// subject) between these times [s]; negative = never. Part of the scene,
+  /// not of the subject.
+  double passer_by_start_s = -1, passer_by_end_s = -1;
   /// IMU: gyro rate [Hz], white noise [rad/s], constant bias [rad/s],
   /// timestamp jitter (std) [s], clock offset: IMU stamps are true time
   /// minus this, so the stabilizer's imu_time_offset must be +this [s].
@@ -103,7 +111,8 @@ struct SimulatorOptions {
 /// readout: what the face tracker is judged on under strong shake), drift,
 /// walk_across, bob (a walking selfie whose head bobs against the scene by
 /// +-100 px at 720p, with neck and shoulders: what the composite is judged
-/// on).
+/// on), hair (vlog with hair strands at the head's top edge), passer_by
+/// (walk with neck and shoulders, a person walking across behind).
 Status ApplyPreset(const std::string& name, SimulatorOptions* options);
 const std::vector<std::string>& PresetNames();
 
@@ -190,7 +199,10 @@ class Simulator {
   /// Time in the real trace for sequence time t (mirrored past its end).
   double RealGyroTime(double t, double* sign) const;
   std::unique_ptr<InfiniteBackground> background_;
-  Billboard face_, second_face_, occluder_, torso_;
+  Billboard face_, second_face_, occluder_, torso_, passer_by_;
+  // hair_edge: the face billboard's top edge as strands.
+  void MakeHair();
+  void MakePasserBy();
   Eigen::Vector2d face_centre_uv_ = Eigen::Vector2d::Zero();
   std::vector<GyroSample> imu_;
 };
