@@ -163,6 +163,48 @@ TEST(SimulatorTest, RealGyroSpeedPlaysTheTraceFasterWithTheSameAmplitude) {
   EXPECT_FALSE(sim::Simulator::Create(o, &s).ok());
 }
 
+// The truth behind the composite: the scene without the subject equals the
+// frame wherever the subject does not cover it, differs under it, and the
+// coverage agrees with SubjectCovers; a passer-by is part of the scene.
+TEST(SimulatorTest, TruthLayersAreTheFrameWithoutTheSubjectAndItsCoverage) {
+  for (const std::string preset : {"vlog", "passer_by"}) {
+    auto s = MakeSimulator(preset);
+    ASSERT_NE(s, nullptr);
+    const int i = s->num_frames() / 2;
+    cv::Mat frame, scene, alpha;
+    sim::SimTruth truth;
+    ASSERT_TRUE(s->Render(i, &frame, &truth).ok());
+    ASSERT_TRUE(s->RenderTruthLayers(i, &scene, &alpha).ok());
+    ASSERT_EQ(alpha.type(), CV_8UC1);
+    cv::Mat diff;
+    cv::absdiff(frame, scene, diff);
+    cv::cvtColor(diff, diff, cv::COLOR_BGR2GRAY);
+    EXPECT_EQ(cv::countNonZero(diff & (alpha == 0)), 0) << preset;
+    EXPECT_GT(cv::countNonZero(diff & (alpha == 255)), 0.5 * cv::countNonZero(alpha == 255)) << preset;
+    int agree = 0, n = 0;
+    for (int y = 5; y < alpha.rows; y += 10) {
+      for (int x = 5; x < alpha.cols; x += 10) {
+        const uchar a = alpha.at<uchar>(y, x);
+        if (a > 20 && a < 235) continue;  // the soft edge
+        agree += (a >= 128) == s->SubjectCovers(i, Eigen::Vector2d(x, y));
+        ++n;
+      }
+    }
+    EXPECT_GT(agree, 0.98 * n) << preset;
+  }
+  // The passer-by, mid-way, is behind the subject: in the scene, not in the
+  // coverage; rendering it changes the scene.
+  auto with = MakeSimulator("passer_by");
+  auto without = MakeSimulator("passer_by", [](sim::SimulatorOptions* o) {
+    o->passer_by_start_s = -1;
+  });
+  cv::Mat a, b, alpha_a, alpha_b;
+  ASSERT_TRUE(with->RenderTruthLayers(30, &a, &alpha_a).ok());
+  ASSERT_TRUE(without->RenderTruthLayers(30, &b, &alpha_b).ok());
+  EXPECT_GT(cv::norm(a, b, cv::NORM_L1), 0.0);
+  EXPECT_EQ(cv::norm(alpha_a, alpha_b, cv::NORM_INF), 0.0);
+}
+
 TEST(SimulatorTest, PresetsAndErrors) {
   for (const auto& p : sim::PresetNames()) {
     auto s = MakeSimulator(p);

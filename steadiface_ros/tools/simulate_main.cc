@@ -42,7 +42,8 @@ int Usage() {
                "   recorded in IMU axes, so the stabilizer needs imu/R_cam_imu = its inverse]\n"
                "  [--calibration-out FILE.yaml: the camera's intrinsics as a camera_calibration\n"
                "   YAML, for camera_info_url]\n"
-               "presets: still walk pan run occlusion two_faces turn_away vlog shake\n";
+               "presets: still walk pan run occlusion two_faces turn_away vlog shake drift\n"
+               "         walk_across bob hair passer_by\n";
   return 2;
 }
 
