@@ -1,33 +1,26 @@
 #include "steadiface_bag/truth_score.h"
 
-#include <chrono>
-#include <cmath>
+#include <dlfcn.h>
+#include <limits.h>
+#include <unistd.h>
+
 #include <vector>
 
-#include "steadiface_core/eval/run_methods.h"
-#include "steadiface_core/sim/truth_file.h"
+#include "steadiface_ros/module_loader.h"
 
 namespace steadiface_bag {
 namespace {
 
-// The rebuilt simulation must reproduce the file's truth (else the photos
-// or the simulator changed since the bag was made).
-steadiface::Status CheckRows(const steadiface::sim::Simulator& sim,
-                             const std::vector<steadiface::sim::TruthRow>& rows) {
-  for (const auto& row : rows) {
-    if (row.frame < 0 || row.frame >= sim.num_frames()) {
-      return steadiface::Status::Error("truth frame " + std::to_string(row.frame) +
-                                       " is not in the rebuilt simulation");
-    }
-    const steadiface::sim::SimTruth t = sim.Truth(row.frame);
-    if (t.head_in_view != row.truth.head_in_view ||
-        (t.head_in_view && (t.head_px - row.truth.head_px).norm() > 1e-6)) {
-      return steadiface::Status::Error(
-          "the rebuilt simulation's head differs from the truth file's at frame " +
-          std::to_string(row.frame));
-    }
-  }
-  return steadiface::Status::Ok();
+constexpr char kModule[] = "libsteadiface_truth_scorer.so";
+
+// The tool's own directory (from /proc/self/exe), or "" if unknown.
+std::string ExeDir() {
+  char buf[PATH_MAX];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+  if (n <= 0) return "";
+  const std::string exe(buf, static_cast<size_t>(n));
+  const size_t slash = exe.rfind('/');
+  return slash == std::string::npos ? "" : exe.substr(0, slash);
 }
 
 }  // namespace
@@ -35,46 +28,29 @@ steadiface::Status CheckRows(const steadiface::sim::Simulator& sim,
 steadiface::Status TruthScorer::Create(const std::string& truth_path,
                                        const steadiface::PipelineOptions& options,
                                        std::unique_ptr<TruthScorer>* out) {
-  steadiface::sim::SimulationSettings settings;
-  bool has_settings = false;
-  std::vector<steadiface::sim::TruthRow> rows;
-  steadiface::Status s = steadiface::sim::ReadTruthFile(truth_path, &settings, &has_settings, &rows);
-  if (!s.ok()) return s;
-  if (!has_settings) {
-    return steadiface::Status::Error("'" + truth_path +
-                                     "' has no simulation settings (made by an older "
-                                     "steadiface_simulate): no ground-truth score");
+  // The tools are in <prefix>/lib/steadiface/ and the libraries in
+  // <prefix>/lib/, in the devel and the install space alike. The module
+  // stays loaded for the rest of the process (its scorer's code).
+  std::vector<std::string> candidates;
+  const std::string dir = ExeDir();
+  if (!dir.empty()) candidates.push_back(dir + "/../" + kModule);
+  candidates.push_back(kModule);
+  std::string errors;
+  void* handle = steadiface_ros::OpenModule(candidates, &errors);
+  if (handle == nullptr) {
+    return steadiface::Status::Error("cannot load the truth scorer module (" + errors + ")");
   }
-  std::unique_ptr<TruthScorer> t(new TruthScorer);
-  steadiface::sim::SimulatorOptions so;
-  s = steadiface::sim::MakeSimulatorOptions(settings, &so);
-  if (s.ok()) s = steadiface::sim::Simulator::Create(so, &t->sim_);
-  if (s.ok()) s = CheckRows(*t->sim_, rows);
-  if (s.ok()) s = steadiface::eval::MakeScorecard(*t->sim_, options, &t->output_);
-  if (s.ok()) s = steadiface::eval::MakeScorecard(*t->sim_, options, &t->input_);
-  if (!s.ok()) return s;
-  t->frame_by_ms_ = steadiface::sim::FramesByStampMs(rows);
-  *out = std::move(t);
+  using Create = TruthScorer* (*)(const std::string&, const steadiface::PipelineOptions&,
+                                  std::string*);
+  auto create = reinterpret_cast<Create>(dlsym(handle, "steadiface_bag_create_truth_scorer"));
+  if (create == nullptr) {
+    return steadiface::Status::Error(std::string("the truth scorer module has no entry point (") +
+                                     kModule + ")");
+  }
+  std::string error;
+  out->reset(create(truth_path, options, &error));
+  if (*out == nullptr) return steadiface::Status::Error(error);
   return steadiface::Status::Ok();
-}
-
-void TruthScorer::Add(steadiface::Time stamp, const steadiface::PipelineFrame& frame,
-                      const steadiface::Pipeline& pipeline) {
-  const auto start = std::chrono::steady_clock::now();
-  AddTimed(stamp, frame, pipeline);
-  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-void TruthScorer::AddTimed(steadiface::Time stamp, const steadiface::PipelineFrame& frame,
-                           const steadiface::Pipeline& pipeline) {
-  const auto it = frame_by_ms_.find(std::llround(steadiface::ToSeconds(stamp) * 1000.0));
-  if (it == frame_by_ms_.end()) {
-    ++unmatched_;
-    return;
-  }
-  output_->Add(it->second, steadiface::eval::MakeFrameWarp(frame, pipeline, false));
-  input_->Add(it->second, steadiface::eval::FrameWarp());
-  ++frames_;
 }
 
 }  // namespace steadiface_bag
