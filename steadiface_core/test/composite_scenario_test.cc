@@ -56,8 +56,8 @@ TEST(CompositeScenarioTest, HeadBobbingAgainstTheSceneKeepsBothTheHeadAndTheScen
   // bob: the head bobs +-100 px at 720p against the scene. Global mode holds
   // the head and moves the scene by it; the composite must hold both.
   // Measured (seed 1): head 50.98 / 9.35 / 9.35 px, visible background
-  // 0.99 / 46.6 / 0.98 px, matte IoU 0.92, plate MAE 9.6 (ideal 2.0),
-  // fallback 0.58.
+  // 0.99 / 46.6 / 0.98 px, matte IoU 0.924, plate MAE 12.4 (ideal 2.1),
+  // fallback 0.47.
   const CompositeRun r = Score("bob");
   const eval::Score& gyro = r.score.at(eval::Method::kGyroOnly);
   const eval::Score& global = r.score.at(eval::Method::kSteadiface);
@@ -70,7 +70,7 @@ TEST(CompositeScenarioTest, HeadBobbingAgainstTheSceneKeepsBothTheHeadAndTheScen
   EXPECT_GT(r.quality.frames, 80);
   EXPECT_GT(r.quality.matte_iou_mean, 0.88);
   EXPECT_LT(r.quality.plate_mae, 15.0);
-  EXPECT_LT(r.quality.fallback_share, 0.75);
+  EXPECT_LT(r.quality.fallback_share, 0.65);
 }
 
 TEST(CompositeScenarioTest, AStillCameraDoesNotChaseTheHead) {

@@ -308,6 +308,7 @@ int main(int argc, char** argv) {
   cl.Double("--plate-max-age", &composite.plate.max_age_s);
   cl.Int("--plate-distance", &composite.plate_distance_px);
   cl.Double("--plate-below", &composite.plate_below);
+  cl.Int("--plate-row-step", &composite.plate_row_step);
   cl.Double("--plate-confidence", &composite.matte.plate_confidence);
   cl.Double("--plate-outlier", &composite.plate.outlier_level);
   cl.ClearFlag("--yield-to-background", &blend.yield_to_subject);
