@@ -108,8 +108,8 @@ void Compositor::ComposeActive(const cv::Mat& subject, const LayerView& subject_
   auto t0 = std::chrono::steady_clock::now();
   report_.active = true;
   report_.background_roi = active;
-  matte_b_ = raw;
-  if (region.blend < 1.0) matte_b_ *= region.blend;
+  // (A copy when scaled: `raw`, unscaled, keeps the subject out of the plate.)
+  matte_b_ = region.blend < 1.0 ? cv::Mat(raw * region.blend) : raw;
   // The matte in the subject layer's view.
   const cv::Rect whole(0, 0, out->cols, out->rows);
   const Eigen::Matrix3d H_sb = HomographyBetween(subject_view, background_view);
