@@ -1,42 +1,22 @@
 #include "steadiface_bag/truth_score.h"
 
 #include <dlfcn.h>
-#include <limits.h>
-#include <unistd.h>
 
-#include <vector>
-
-#include "steadiface_ros/module_loader.h"
+#include "steadiface_bag/tool_module.h"
 
 namespace steadiface_bag {
 namespace {
 
 constexpr char kModule[] = "libsteadiface_truth_scorer.so";
 
-// The tool's own directory (from /proc/self/exe), or "" if unknown.
-std::string ExeDir() {
-  char buf[PATH_MAX];
-  const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
-  if (n <= 0) return "";
-  const std::string exe(buf, static_cast<size_t>(n));
-  const size_t slash = exe.rfind('/');
-  return slash == std::string::npos ? "" : exe.substr(0, slash);
-}
-
 }  // namespace
 
 steadiface::Status TruthScorer::Create(const std::string& truth_path,
                                        const steadiface::PipelineOptions& options,
                                        std::unique_ptr<TruthScorer>* out) {
-  // The tools are in <prefix>/lib/steadiface/ and the libraries in
-  // <prefix>/lib/, in the devel and the install space alike. The module
-  // stays loaded for the rest of the process (its scorer's code).
-  std::vector<std::string> candidates;
-  const std::string dir = ExeDir();
-  if (!dir.empty()) candidates.push_back(dir + "/../" + kModule);
-  candidates.push_back(kModule);
+  // The module stays loaded for the rest of the process (its scorer's code).
   std::string errors;
-  void* handle = steadiface_ros::OpenModule(candidates, &errors);
+  void* handle = OpenToolModule(kModule, &errors);
   if (handle == nullptr) {
     return steadiface::Status::Error("cannot load the truth scorer module (" + errors + ")");
   }

@@ -1,12 +1,8 @@
 #include "steadiface_bag/video_encoder.h"
 
 #include <dlfcn.h>
-#include <limits.h>
-#include <unistd.h>
 
-#include <vector>
-
-#include "steadiface_ros/module_loader.h"
+#include "steadiface_bag/tool_module.h"
 
 namespace steadiface_bag {
 
@@ -14,30 +10,14 @@ namespace {
 
 constexpr char kModule[] = "libsteadiface_video_encoder.so";
 
-// The tool's own directory (from /proc/self/exe), or "" if unknown.
-std::string ExeDir() {
-  char buf[PATH_MAX];
-  const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
-  if (n <= 0) return "";
-  const std::string exe(buf, static_cast<size_t>(n));
-  const size_t slash = exe.rfind('/');
-  return slash == std::string::npos ? "" : exe.substr(0, slash);
-}
-
 }  // namespace
 
 std::unique_ptr<VideoEncoder> OpenVideoEncoder(const std::string& path,
                                                double fps, cv::Size size,
                                                std::string* why) {
-  // The tools are in <prefix>/lib/steadiface/ and the libraries in
-  // <prefix>/lib/, in the devel and the install space alike. The module
-  // stays loaded for the rest of the process (its encoder's code).
-  std::vector<std::string> candidates;
-  const std::string dir = ExeDir();
-  if (!dir.empty()) candidates.push_back(dir + "/../" + kModule);
-  candidates.push_back(kModule);
+  // The module stays loaded for the rest of the process (its encoder's code).
   std::string errors;
-  void* handle = steadiface_ros::OpenModule(candidates, &errors);
+  void* handle = OpenToolModule(kModule, &errors);
   if (handle == nullptr) {
     *why = "cannot load the video encoder module (" + errors + ")";
     return nullptr;
