@@ -5,6 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/common/grey.h"
 #include "steadiface_core/composite/guided_filter.h"
 
 namespace steadiface {
@@ -16,12 +17,6 @@ bool In(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && 
 
 float Clamp(float v, float lo, float hi) { return std::min(hi, std::max(lo, v)); }
 
-cv::Mat Grey(const cv::Mat& m) {
-  if (m.channels() == 1) return m;
-  cv::Mat g;
-  cv::cvtColor(m, g, m.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
-  return g;
-}
 
 int Bin(const uchar* px, int cn) {
   if (cn == 1) return px[0] * kLevels / 256;
@@ -118,9 +113,9 @@ void SubjectMatte::Estimate(const MatteInputs& in, cv::Rect* active, cv::Mat* ma
   const cv::Size small((in.background.cols + s - 1) / s, (in.background.rows + s - 1) / s);
   cv::Mat bg_small, subject_small;
   cv::resize(in.background, bg_small, small, 0, 0, cv::INTER_AREA);
-  low.background = Grey(bg_small);
+  low.background = ToGrey(bg_small);
   cv::resize(in.subject, subject_small, small, 0, 0, cv::INTER_AREA);
-  low.subject = Grey(subject_small);
+  low.subject = ToGrey(subject_small);
   low.roi = LowRoi(in.roi, small);
   low.colour = bg_small(low.roi);
   low.plate = in.plate;

@@ -57,6 +57,12 @@ double BandIou(const cv::Mat& T, const cv::Mat& E, const cv::Mat& k) {
   return uni > 0 ? cv::countNonZero(T & E & scored) / uni : 1.0;
 }
 
+// The structuring element of the band left out around the true outline.
+cv::Mat EdgeBand() {
+  const int k = 2 * CompositeQuality::kEdgeBandPx + 1;
+  return cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k));
+}
+
 }  // namespace
 
 Status CompositeQuality::Create(const sim::Simulator& sim, const Pipeline& pipeline,
@@ -130,15 +136,9 @@ Status CompositeQuality::Add(int index, const Pipeline& pipeline, const Pipeline
 void CompositeQuality::AddMatte(int index, const cv::Mat& truth, const cv::Mat& matte) {
   // IoU outside the band around the true outline.
   const cv::Mat T = truth >= 0.5, E = matte >= 0.5;
-  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT,
-                                              cv::Size(2 * kEdgeBandPx + 1, 2 * kEdgeBandPx + 1));
-  cv::Mat grown, shrunk;
-  cv::dilate(T, grown, k);
-  cv::erode(T, shrunk, k);
-  const cv::Mat scored = ~(grown & ~shrunk);
-  if (cv::countNonZero(T & scored) < 200) return;
-  const double inter = cv::countNonZero(T & E & scored), uni = cv::countNonZero((T | E) & scored);
-  iou_.push_back(uni > 0 ? inter / uni : 1.0);
+  const double iou = BandIou(T, E, EdgeBand());
+  if (!std::isfinite(iou)) return;
+  iou_.push_back(iou);
   iou_frames_.push_back(index);
   // The matte's outline against the true one.
   cv::Mat edge_t, edge_e, dist;
@@ -154,13 +154,11 @@ void CompositeQuality::AddSubtractors(const cv::Mat& truth, const cv::Mat& pictu
     knn_ = cv::createBackgroundSubtractorKNN(500, 400.0, false);
   }
   const cv::Mat T = truth >= 0.5;
-  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT,
-                                              cv::Size(2 * kEdgeBandPx + 1, 2 * kEdgeBandPx + 1));
   cv::Mat fg;
   mog2_->apply(picture, fg);
-  const double m = BandIou(T, fg > 127, k);
+  const double m = BandIou(T, fg > 127, EdgeBand());
   knn_->apply(picture, fg);
-  const double n = BandIou(T, fg > 127, k);
+  const double n = BandIou(T, fg > 127, EdgeBand());
   if (std::isfinite(m)) mog2_iou_.push_back(m);
   if (std::isfinite(n)) knn_iou_.push_back(n);
 }
