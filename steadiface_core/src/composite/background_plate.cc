@@ -144,29 +144,21 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
     seen_.setTo(cv::Scalar(kNever));
   }
   const cv::Rect all(0, 0, plate_.cols, plate_.rows);
-  const Eigen::Matrix3d H = PlateFromView();
-  const cv::Rect target = MapRect(H, roi, all);
+  const cv::Rect target = MapRect(PlateFromView(), roi, all);
   if (target.empty()) return true;
   // Each plate pixel of the target looks up the view pixel it shows: the
-  // matte there (nearest), and, where it is the scene, the picture
-  // (bilinear). Every `row_step`-th row, starting at `row_phase`.
-  const Eigen::Matrix3d G = H.inverse();
+  // matte there (nearest; outside the roi: not taken) and, where it is the
+  // scene, the picture (bilinear). Every `row_step`-th row, starting at
+  // `row_phase`.
+  cv::Mat matte8 = matte_roi;
+  if (matte_roi.depth() != CV_8U) matte_roi.convertTo(matte8, CV_8U, 255.0);
+  const int below = static_cast<int>(std::ceil(background_below * 255.0f));
+  const Eigen::Matrix3d G = HomographyBetween(view_, anchor_);  // view <- plate
   double diff = 0.0;
   int compared = 0;
   const int step = std::max(1, row_step), first = target.y + ((row_phase % step) + step) % step;
-  const double w1 = roi.width - 1.0, h1 = roi.height - 1.0;
   for (int y = first; y < target.y + target.height; y += step) {
-    const Eigen::Vector3d r0 = G * Eigen::Vector3d(target.x, y, 1.0);
-    double X = r0.x(), Y = r0.y(), Z = r0.z();
-    for (int x = 0; x < target.width; ++x, X += G(0, 0), Y += G(1, 0), Z += G(2, 0)) {
-      const double vx = X / Z - roi.x, vy = Y / Z - roi.y;
-      if (!(vx >= 0.0 && vy >= 0.0 && vx <= w1 && vy <= h1)) continue;
-      if (!(matte_roi.at<float>(static_cast<int>(vy + 0.5), static_cast<int>(vx + 0.5)) <
-            background_below)) {
-        continue;
-      }
-      UpdatePixel(image_roi, vx, vy, target.x + x, y, &diff, &compared);
-    }
+    UpdateRow(image_roi, matte8, below, G, roi, target.x, y, target.width, &diff, &compared);
   }
   if (compared > 400 && diff / compared > options_.scene_cut_level) {
     Reset();
@@ -176,40 +168,64 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
   return true;
 }
 
-void BackgroundPlate::UpdatePixel(const cv::Mat& image, double vx, double vy, int px, int py,
-                                  double* diff, int* compared) {
+void BackgroundPlate::UpdateRow(const cv::Mat& image, const cv::Mat& matte, int below,
+                                const Eigen::Matrix3d& G, const cv::Rect& roi, int x0, int py,
+                                int width, double* diff, int* compared) {
   const int cn = plate_.channels();
-  const int x0 = std::min(static_cast<int>(vx), image.cols - 2);
-  const int y0 = std::min(static_cast<int>(vy), image.rows - 2);
-  const float fx = static_cast<float>(vx - x0), fy = static_cast<float>(vy - y0);
-  const uchar* r0 = image.ptr<uchar>(y0) + cn * x0;
-  const uchar* r1 = image.ptr<uchar>(y0 + 1) + cn * x0;
-  float in[4];
-  for (int c = 0; c < cn; ++c) {
-    in[c] = (1 - fy) * ((1 - fx) * r0[c] + fx * r0[c + cn]) + fy * ((1 - fx) * r1[c] + fx * r1[c + cn]);
+  uchar* p = plate_.ptr<uchar>(py) + cn * x0;
+  float* seen = seen_.ptr<float>(py) + x0;
+  const float now = static_cast<float>(now_), max_age = static_cast<float>(options_.max_age_s);
+  const int outlier = static_cast<int>(options_.outlier_level * cn);
+  // The running average's weight of this frame, in 1/256 steps.
+  const int rate = static_cast<int>(std::lround(options_.update_rate * 256.0));
+  const float w1 = roi.width - 1.0f, h1 = roi.height - 1.0f;
+  const Eigen::Vector3d r0 = G * Eigen::Vector3d(x0, py, 1.0) - Eigen::Vector3d(roi.x, roi.y, 0.0) *
+                                                                   (G(2, 0) * x0 + G(2, 1) * py + G(2, 2));
+  // (r0 is the view point relative to the roi, homogeneous; each step adds
+  // G's first column, less the roi's corner times its z step.)
+  const double dx = G(0, 0) - roi.x * G(2, 0), dy = G(1, 0) - roi.y * G(2, 0), dz = G(2, 0);
+  double X = r0.x(), Y = r0.y(), Z = r0.z();
+  for (int x = 0; x < width; ++x, X += dx, Y += dy, Z += dz, p += cn) {
+    const float iz = static_cast<float>(1.0 / Z);
+    const float vx = static_cast<float>(X) * iz, vy = static_cast<float>(Y) * iz;
+    if (!(vx >= 0.0f && vy >= 0.0f && vx <= w1 && vy <= h1)) continue;
+    if (matte.ptr<uchar>(static_cast<int>(vy + 0.5f))[static_cast<int>(vx + 0.5f)] >= below) continue;
+    const int ix = std::min(static_cast<int>(vx), image.cols - 2);
+    const int iy = std::min(static_cast<int>(vy), image.rows - 2);
+    const float fx = vx - ix, fy = vy - iy;
+    const uchar* a = image.ptr<uchar>(iy) + cn * ix;
+    const uchar* b = image.ptr<uchar>(iy + 1) + cn * ix;
+    int in[4];
+    for (int c = 0; c < cn; ++c) {
+      in[c] = static_cast<int>((1 - fy) * ((1 - fx) * a[c] + fx * a[c + cn]) +
+                               fy * ((1 - fx) * b[c] + fx * b[c + cn]) + 0.5f);
+    }
+    const bool fresh = now - seen[x] < max_age;
+    if (fresh) {
+      int d = 0;
+      for (int c = 0; c < cn; ++c) d += std::abs(in[c] - p[c]);
+      *diff += static_cast<double>(d) / cn;
+      ++*compared;
+      // A fresh pixel that disagrees this much is more likely a subject's
+      // edge than the scene: not taken; it expires if the scene really
+      // changed.
+      if (d > outlier) continue;
+      for (int c = 0; c < cn; ++c) p[c] = static_cast<uchar>(p[c] + ((rate * (in[c] - p[c]) + 128) >> 8));
+    } else {
+      for (int c = 0; c < cn; ++c) p[c] = static_cast<uchar>(in[c]);
+    }
+    seen[x] = now;
   }
-  uchar* p = plate_.ptr<uchar>(py) + cn * px;
-  float& seen = seen_.at<float>(py, px);
-  const bool fresh = now_ - seen < options_.max_age_s;
-  float d = 0.0f;
-  for (int c = 0; c < cn; ++c) d += std::abs(in[c] - p[c]);
-  if (fresh) {
-    *diff += d / cn;
-    ++*compared;
-    // A fresh pixel that disagrees this much is more likely a subject's edge
-    // than the scene: not taken; it expires if the scene really changed.
-    if (d > options_.outlier_level * cn) return;
-  }
-  const float a = fresh ? static_cast<float>(options_.update_rate) : 1.0f;
-  for (int c = 0; c < cn; ++c) p[c] = cv::saturate_cast<uchar>(p[c] + a * (in[c] - p[c]));
-  seen = static_cast<float>(now_);
 }
 
 float BackgroundPlate::SampleAt(double x, double y, uchar* colour) const {
-  // The plate pixel the view pixel (x, y) shows, bilinear; fresh only where
-  // all four are.
+  // The plate pixel the view pixel (x, y) shows.
   const Eigen::Vector3d q = view_to_plate_ * Eigen::Vector3d(x, y, 1.0);
-  const double px = q.x() / q.z(), py = q.y() / q.z();
+  return SamplePlate(q.x() / q.z(), q.y() / q.z(), colour);
+}
+
+float BackgroundPlate::SamplePlate(double px, double py, uchar* colour) const {
+  // Bilinear; fresh only where all four plate pixels are.
   if (!(px >= 0.0 && py >= 0.0 && px < plate_.cols - 1.0 && py < plate_.rows - 1.0)) return 0.0f;
   const int x0 = static_cast<int>(px), y0 = static_cast<int>(py);
   const float* s0 = seen_.ptr<float>(y0) + x0;

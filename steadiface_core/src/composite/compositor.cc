@@ -7,9 +7,6 @@
 namespace steadiface {
 namespace {
 
-// A matte below this is no subject (the guided filter leaves small values
-// everywhere; they would not change an 8-bit pixel).
-constexpr float kNone = 1.0f / 512.0f;
 // A fill that shows through the subject by less than this is not made.
 constexpr float kFillNone = 1.0f / 64.0f;
 
@@ -69,6 +66,7 @@ Status Compositor::Compose(const cv::Mat& subject, const LayerView& subject_view
   report_.plate_restarts = plate_.restarts();
   report_.plate_reprojections = plate_.reprojections();
   matte_b_.release();
+  matte_b8_.release();
   matte_s_.release();
   plate_weight_.release();
   plate_sample_.release();
@@ -110,14 +108,15 @@ void Compositor::ComposeActive(const cv::Mat& subject, const LayerView& subject_
   report_.background_roi = active;
   // (A copy when scaled: `raw`, unscaled, keeps the subject out of the plate.)
   matte_b_ = region.blend < 1.0 ? cv::Mat(raw * region.blend) : raw;
-  // The matte in the subject layer's view.
+  matte_b_.convertTo(matte_b8_, CV_8U, 255.0);
+  // The matte in the subject layer's view (in 1/255 steps, as it is blended).
   const cv::Rect whole(0, 0, out->cols, out->rows);
   const Eigen::Matrix3d H_sb = HomographyBetween(subject_view, background_view);
   const Eigen::Matrix3d H_bs = HomographyBetween(background_view, subject_view);
   const cv::Rect roi_s = MapRect(H_sb, active, whole);
   report_.subject_roi = roi_s;
   if (!roi_s.empty()) {
-    cv::warpPerspective(matte_b_, matte_s_, RectMap(H_bs, active, 1.0, roi_s, 1.0), roi_s.size(),
+    cv::warpPerspective(matte_b8_, matte_s_, RectMap(H_bs, active, 1.0, roi_s, 1.0), roi_s.size(),
                         cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
                         cv::Scalar(0));
   }
@@ -138,17 +137,21 @@ void Compositor::UpdatePlate(const cv::Mat& background, const cv::Rect& roi, con
   const cv::Rect view_rl(rl.x * s, rl.y * s, rl.width * s, rl.height * s);
   const cv::Rect update = view_rl & roi;
   if (update.empty() || matte_.scene_known_low().empty()) return;
-  cv::Mat known_up, blocked;
-  cv::resize(matte_.scene_known_low(), known_up, view_rl.size(), 0, 0, cv::INTER_NEAREST);
-  blocked = 1.0 - known_up(cv::Rect(update.x - view_rl.x, update.y - view_rl.y, update.width,
-                                    update.height));
+  // Blocked (255) where the scene is not known, in 1/255 steps like the
+  // matte, and within plate_distance_px of the subject.
+  cv::Mat unknown;
+  matte_.scene_known_low().convertTo(unknown, CV_8U, -255.0, 255.0);
+  cv::resize(unknown, blocked_, view_rl.size(), 0, 0, cv::INTER_NEAREST);
+  cv::Mat blocked = blocked_(cv::Rect(update.x - view_rl.x, update.y - view_rl.y, update.width,
+                                      update.height));
   if (!active.empty()) {
     const int g = 2 * options_.plate_distance_px + 1;
-    cv::Mat grown;
-    cv::dilate(raw, grown, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(g, g)));
+    cv::Mat raw8;
+    raw.convertTo(raw8, CV_8U, 255.0);
+    cv::dilate(raw8, raw8, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(g, g)));
     const cv::Rect a = active & update;
     cv::Mat b = blocked(cv::Rect(a.x - update.x, a.y - update.y, a.width, a.height));
-    cv::max(b, grown(cv::Rect(a.x - active.x, a.y - active.y, a.width, a.height)), b);
+    cv::max(b, raw8(cv::Rect(a.x - active.x, a.y - active.y, a.width, a.height)), b);
   }
   plate_.Update(background(update), blocked, update, static_cast<float>(options_.plate_below),
                 options_.plate_row_step, frame_++);
@@ -164,28 +167,31 @@ void Compositor::FillUncovered(const cv::Mat& subject, cv::Mat* out) {
     plate_weight_ = cv::Mat::zeros(rb.size(), CV_32F);
     plate_sample_ = cv::Mat::zeros(rb.size(), out->type());
   }
+  const Eigen::Matrix3d& G = plate_.view_to_plate();
   uchar scratch[4];
-  double uncovered = 0.0, filled = 0.0, matte_sum = 0.0;
+  double uncovered = 0.0, filled = 0.0;
   for (int y = 0; y < rb.height; ++y) {
     const int Y = rb.y + y;
-    const float* mb = matte_b_.ptr<float>(y);
+    const uchar* mb = matte_b8_.ptr<uchar>(y);
     const uchar* S = subject.ptr<uchar>(Y) + cn * rb.x;
     uchar* O = out->ptr<uchar>(Y) + cn * rb.x;
     uchar* P = keep_plate_ ? plate_sample_.ptr<uchar>(y) : nullptr;
     const bool in_s = Y >= rs.y && Y < rs.y + rs.height;
-    const float* ms = in_s ? matte_s_.ptr<float>(Y - rs.y) : nullptr;
+    const uchar* ms = in_s ? matte_s_.ptr<uchar>(Y - rs.y) : nullptr;
     float* w = keep_plate_ ? plate_weight_.ptr<float>(y) : nullptr;
+    // The plate pixel of the row's first output pixel, stepped along the row.
+    const Eigen::Vector3d q0 = G * Eigen::Vector3d(rb.x, Y, 1.0);
     for (int x = 0; x < rb.width; ++x) {
-      const float m = mb[x];
-      matte_sum += m;
-      if (m < kNone) continue;
+      if (mb[x] == 0) continue;
       const int X = rb.x + x;
-      const float m_s = in_s && X >= rs.x && X < rs.x + rs.width ? ms[X - rs.x] : 0.0f;
+      const float m = mb[x] * (1.0f / 255.0f);
+      const float m_s = in_s && X >= rs.x && X < rs.x + rs.width ? ms[X - rs.x] * (1.0f / 255.0f) : 0.0f;
       // The subject covers it (Blend draws it), or what would show of the
       // fill under it is negligible.
       if (m * (1.0f - m_s) < kFillNone) continue;
       uchar* p = P != nullptr ? P + cn * x : scratch;
-      const float v = plate_.SampleAt(X, Y, p);
+      const Eigen::Vector3d q = q0 + x * G.col(0);
+      const float v = plate_.SamplePlate(q.x() / q.z(), q.y() / q.z(), p);
       uncovered += m * (1.0f - m_s);
       filled += m * v * (1.0f - m_s);
       if (w != nullptr) w[x] = m * v * (1.0f - m_s);
@@ -196,7 +202,7 @@ void Compositor::FillUncovered(const cv::Mat& subject, cv::Mat* out) {
       }
     }
   }
-  report_.matte_mean = matte_sum / std::max(1, rb.area());
+  report_.matte_mean = cv::sum(matte_b8_)[0] / 255.0 / std::max(1, rb.area());
   report_.uncovered_px = uncovered;
   report_.plate_share = uncovered > 0.0 ? filled / uncovered : 0.0;
   report_.fallback_share = uncovered > 0.0 ? 1.0 - report_.plate_share : 0.0;
@@ -207,16 +213,16 @@ void Compositor::Blend(const cv::Mat& subject, cv::Mat* out) {
   const cv::Rect& rs = report_.subject_roi;
   const int cn = out->channels();
   for (int y = 0; y < rs.height; ++y) {
-    const float* m = matte_s_.ptr<float>(y);
+    const uchar* m = matte_s_.ptr<uchar>(y);
     const uchar* S = subject.ptr<uchar>(rs.y + y) + cn * rs.x;
     uchar* O = out->ptr<uchar>(rs.y + y) + cn * rs.x;
     for (int x = 0; x < rs.width; ++x) {
-      const int w = static_cast<int>(m[x] * 256.0f + 0.5f);
-      if (w <= 0) continue;
-      if (w >= 256) {
+      if (m[x] == 0) continue;
+      if (m[x] == 255) {
         for (int c = cn * x; c < cn * (x + 1); ++c) O[c] = S[c];
         continue;
       }
+      const int w = m[x] + (m[x] >> 7);  // 0..255 -> 0..256
       for (int c = cn * x; c < cn * (x + 1); ++c) O[c] = static_cast<uchar>(O[c] + ((w * (S[c] - O[c]) + 128) >> 8));
     }
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -175,57 +176,64 @@ void SubjectMatte::Refine(const MatteInputs& in, const LowRes& low, const cv::Ma
   // Where the coefficient a is small the guide's detail does not show: the
   // low-resolution output, interpolated. Elsewhere (the edges) a I + b per
   // pixel, with a and b interpolated.
-  const cv::Mat q_low = mean_a.mul(guide_low) + mean_b;
+  cv::Mat q_low = mean_a.mul(guide_low) + mean_b;
+  cv::min(q_low, 1.0, q_low);
+  cv::max(q_low, 0.0, q_low);
   cv::Mat base;
   const cv::Size up(low_active.width * s, low_active.height * s);
   cv::resize(q_low(low_active), base, up, 0, 0, cv::INTER_LINEAR);
   const cv::Rect crop(active->x - (low.roi.x + low_active.x) * s,
                       active->y - (low.roi.y + low_active.y) * s, active->width, active->height);
-  *matte = base(crop).clone();
+  *matte = base(crop);
   cv::Mat edge = cv::abs(mean_a) > 0.02;
   cv::dilate(edge, edge, cv::Mat());
   RefineEdges(in.background, low.roi, *active, mean_a, mean_b, edge, matte);
-  cv::min(*matte, 1.0, *matte);
-  cv::max(*matte, 0.0, *matte);
 }
 
 void SubjectMatte::RefineEdges(const cv::Mat& picture, const cv::Rect& low_roi,
                                const cv::Rect& active, const cv::Mat& mean_a,
                                const cv::Mat& mean_b, const cv::Mat& edge, cv::Mat* matte) const {
   // a I + b at full resolution in the low cells marked `edge`, a and b
-  // interpolated bilinearly between the low pixels' centres; other cells
-  // keep the interpolated low-resolution output.
+  // interpolated bilinearly between the low pixels' centres, clamped to
+  // [0, 1]; other cells keep the interpolated low-resolution output. Each
+  // row interpolates a and b between two low rows first.
   const int s = options_.scale, cn = picture.channels();
   const float inv = 1.0f / s;
-  auto lerp = [](const cv::Mat& k, int u0, int v0, float fu, float fv) {
-    const float* r0 = k.ptr<float>(v0) + u0;
-    const float* r1 = k.ptr<float>(v0 + 1) + u0;
-    return (1 - fv) * ((1 - fu) * r0[0] + fu * r0[1]) + fv * ((1 - fu) * r1[0] + fu * r1[1]);
-  };
-  for (int cy = 0; cy < edge.rows; ++cy) {
+  std::vector<int> u0(active.width);
+  std::vector<float> fu(active.width);
+  for (int i = 0; i < active.width; ++i) {
+    const float u = (active.x + i + 0.5f) * inv - 0.5f - low_roi.x;
+    u0[i] = std::max(0, std::min(mean_a.cols - 2, static_cast<int>(std::floor(u))));
+    fu[i] = std::min(1.0f, std::max(0.0f, u - u0[i]));
+  }
+  std::vector<float> a_row(mean_a.cols), b_row(mean_a.cols);
+  for (int Y = active.y; Y < active.y + active.height; ++Y) {
+    const int cy = Y / s - low_roi.y;
+    if (cy < 0 || cy >= edge.rows) continue;
     const uchar* e = edge.ptr<uchar>(cy);
-    const int Y0 = std::max(active.y, (low_roi.y + cy) * s);
-    const int Y1 = std::min(active.y + active.height, (low_roi.y + cy + 1) * s);
-    for (int cx = 0; cx < edge.cols; ++cx) {
-      if (!e[cx]) continue;
-      const int X0 = std::max(active.x, (low_roi.x + cx) * s);
-      const int X1 = std::min(active.x + active.width, (low_roi.x + cx + 1) * s);
-      for (int Y = Y0; Y < Y1; ++Y) {
-        const float v = (Y + 0.5f) * inv - 0.5f - low_roi.y;
-        const int v0 = std::max(0, std::min(mean_a.rows - 2, static_cast<int>(std::floor(v))));
-        const float fv = std::min(1.0f, std::max(0.0f, v - v0));
-        const uchar* px = picture.ptr<uchar>(Y);
-        float* m = matte->ptr<float>(Y - active.y) - active.x;
-        for (int X = X0; X < X1; ++X) {
-          const float u = (X + 0.5f) * inv - 0.5f - low_roi.x;
-          const int u0 = std::max(0, std::min(mean_a.cols - 2, static_cast<int>(std::floor(u))));
-          const float fu = std::min(1.0f, std::max(0.0f, u - u0));
-          const uchar* c = px + cn * X;
-          const float I = cn >= 3 ? (0.114f * c[0] + 0.587f * c[1] + 0.299f * c[2]) / 255.0f
-                                  : c[0] / 255.0f;
-          m[X] = lerp(mean_a, u0, v0, fu, fv) * I + lerp(mean_b, u0, v0, fu, fv);
-        }
-      }
+    bool any = false;
+    for (int cx = 0; cx < edge.cols && !any; ++cx) any = e[cx] != 0;
+    if (!any) continue;
+    const float v = (Y + 0.5f) * inv - 0.5f - low_roi.y;
+    const int v0 = std::max(0, std::min(mean_a.rows - 2, static_cast<int>(std::floor(v))));
+    const float fv = std::min(1.0f, std::max(0.0f, v - v0));
+    for (int u = 0; u < mean_a.cols; ++u) {
+      a_row[u] = (1 - fv) * mean_a.at<float>(v0, u) + fv * mean_a.at<float>(v0 + 1, u);
+      b_row[u] = (1 - fv) * mean_b.at<float>(v0, u) + fv * mean_b.at<float>(v0 + 1, u);
+    }
+    const uchar* px = picture.ptr<uchar>(Y);
+    float* m = matte->ptr<float>(Y - active.y);
+    for (int i = 0; i < active.width; ++i) {
+      const int X = active.x + i, cx = X / s - low_roi.x;
+      if (cx < 0 || cx >= edge.cols || !e[cx]) continue;
+      const uchar* c = px + cn * X;
+      const float I = cn >= 3 ? (0.114f * c[0] + 0.587f * c[1] + 0.299f * c[2]) / 255.0f
+                              : c[0] / 255.0f;
+      const int k = u0[i];
+      const float f = fu[i];
+      const float a = (1 - f) * a_row[k] + f * a_row[k + 1];
+      const float b = (1 - f) * b_row[k] + f * b_row[k + 1];
+      m[i] = std::min(1.0f, std::max(0.0f, a * I + b));
     }
   }
 }

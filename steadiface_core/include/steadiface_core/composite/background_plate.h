@@ -66,9 +66,13 @@ class BackgroundPlate {
   /// `colour` (the images' channels); returns its freshness in [0, 1] (0:
   /// not seen, expired or outside; then `colour` is not written).
   float SampleAt(double x, double y, uchar* colour) const;
+  /// The same at plate pixel (px, py); view_to_plate() maps output pixels
+  /// of the current view to plate pixels.
+  float SamplePlate(double px, double py, uchar* colour) const;
+  const Eigen::Matrix3d& view_to_plate() const { return view_to_plate_; }
   /// Takes this frame's background (`image_roi`, 8-bit, 1-4 channels, output rectangle
-  /// `roi`) where `matte_roi` (CV_32F, subject coverage) is below
-  /// `background_below`, on every `row_step`-th plate row from `row_phase`
+  /// `roi`) where `matte_roi` (subject coverage: CV_32F in [0, 1], or CV_8U
+  /// in 1/255 steps) is below `background_below`, on every `row_step`-th plate row from `row_phase`
   /// (a caller alternating the phase spreads the work over frames). Returns
   /// false (and restarts the plate) on a scene cut.
   bool Update(const cv::Mat& image_roi, const cv::Mat& matte_roi, const cv::Rect& roi,
@@ -89,10 +93,12 @@ class BackgroundPlate {
   // Plate pixel <- output pixel of the current view.
   Eigen::Matrix3d PlateFromView() const { return HomographyBetween(anchor_, view_); }
   bool ViewInside() const;
-  // Update's per-pixel step: plate pixel (px, py) takes the picture at
-  // (vx, vy) of `image` (bilinear), unless it is a fresh pixel's outlier.
-  void UpdatePixel(const cv::Mat& image, double vx, double vy, int px, int py, double* diff,
-                   int* compared);
+  // Update's step over `width` plate pixels of row py from x0: each takes
+  // the picture (`image`, over output rectangle `roi`) at the view pixel G
+  // maps it to, where `matte` (1/255 steps, over `roi`) is below `below`,
+  // unless it is a fresh pixel's outlier.
+  void UpdateRow(const cv::Mat& image, const cv::Mat& matte, int below, const Eigen::Matrix3d& G,
+                 const cv::Rect& roi, int x0, int py, int width, double* diff, int* compared);
   void Reproject();
 
   const OutputGeometry output_;

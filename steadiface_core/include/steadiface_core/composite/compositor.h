@@ -87,8 +87,8 @@ class Compositor {
 
   const CompositeReport& report() const { return report_; }
   /// The last matte in the background layer's view over
-  /// report().background_roi, and moved into the subject layer's view over
-  /// report().subject_roi (CV_32F, [0, 1]).
+  /// report().background_roi (CV_32F, [0, 1]), and moved into the subject
+  /// layer's view over report().subject_roi (CV_8U, 255 = subject).
   const cv::Mat& background_matte() const { return matte_b_; }
   const cv::Mat& subject_matte() const { return matte_s_; }
   /// With KeepPlateUse(true), over the background roi: the plate's weight in
@@ -120,7 +120,9 @@ class Compositor {
   SubjectMatte matte_;
   BackgroundPlate plate_;
   CompositeReport report_;
-  cv::Mat matte_b_, matte_s_, plate_weight_, plate_sample_;
+  cv::Mat matte_b_, plate_weight_, plate_sample_;
+  cv::Mat matte_b8_, matte_s_;  // the matte in 1/255 steps in both views
+  cv::Mat blocked_;             // UpdatePlate's scratch (kept: no allocation per frame)
   bool keep_plate_ = false;
   int frame_ = 0;  // frames composed (the plate's row phase)
 };
