@@ -215,6 +215,7 @@ void ReadRosLayer(Reader& r, steadiface::PipelineOptions* po, WrapperOptions* wo
   using steadiface::LandmarkSource;
   using steadiface::LateFramePolicy;
   r.Str("camera_frame", &wo->camera_frame);
+  r.Choice("image_transport", &wo->image_transport);
   r.Str("camera_info_url", &wo->camera_info_url);
   r.Str("stabilized_suffix", &wo->stabilized_suffix);
   r.Str("world_frame", &wo->world_frame);

@@ -116,6 +116,7 @@ void StabilizerRos::StartDiagnostics() {
   updater_->add("frames", this, &StabilizerRos::DiagFrames);
   updater_->add("protrusion", this, &StabilizerRos::DiagProtrusion);
   updater_->add("gyro vs video", this, &StabilizerRos::DiagGyroVideo);
+  updater_->add("IMU extrinsics", this, &StabilizerRos::DiagExtrinsics);
 }
 
 // Subscribes the inputs; returns the image transport in use (and whether
@@ -123,23 +124,16 @@ void StabilizerRos::StartDiagnostics() {
 std::string StabilizerRos::Subscribe(bool* builtin_compressed_out) {
   imu_sub_ = nh_.subscribe("imu", 2000, &StabilizerRos::OnImu, this,
                            ros::TransportHints().tcpNoDelay());
-  // ~image_transport (raw | compressed | ...), read from this node's private
-  // namespace (not the nodelet manager's). Debian 12 ships no
-  // compressed_image_transport plugin: without it, "compressed" subscribes
-  // to image_raw/compressed and decodes with the built-in jpeg/png decoder.
-  std::string transport = "raw";
-  pnh_.param<std::string>("image_transport", transport, "raw");
+  // ~image_transport (raw | compressed; LoadOptions refused anything else).
+  // Debian 12 ships no compressed_image_transport plugin: without it,
+  // "compressed" subscribes to image_raw/compressed and decodes with the
+  // built-in jpeg/png decoder.
+  std::string transport = wrapper_options_.image_transport;
   bool plugin = transport == "raw";
   for (const std::string& t : it_->getLoadableTransports()) {
     plugin = plugin || t == transport || t == "image_transport/" + transport;
   }
   const bool builtin_compressed = !plugin && transport == "compressed";
-  if (!plugin && !builtin_compressed) {
-    ROS_ERROR("[%s] image_transport '%s' is not installed (available: raw, compressed); "
-              "using raw",
-              name_.c_str(), transport.c_str());
-    transport = "raw";
-  }
   const image_transport::TransportHints hints(builtin_compressed ? "raw" : transport,
                                               ros::TransportHints(), pnh_);
   if (builtin_compressed) {
@@ -243,7 +237,7 @@ bool StabilizerRos::LookupExtrinsic(const std::string& imu_frame,
   try {
     // Rotation taking IMU-frame vectors into the camera frame.
     const geometry_msgs::TransformStamped t =
-        tf_buffer_->lookupTransform(camera_frame, imu_frame, ros::Time(0), ros::Duration(0.05));
+        tf_buffer_->lookupTransform(camera_frame, imu_frame, ros::Time(0));  // no wait: tried again next frame
     const auto& r = t.transform.rotation;
     Eigen::Quaterniond e(r.w, r.x, r.y, r.z);
     if (!(e.norm() > 0.5)) return false;
@@ -316,6 +310,32 @@ void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
               "IMU rejects, gaps or extrapolated frames (see values)");
   } else {
     s.summary(diagnostic_msgs::DiagnosticStatus::OK, "gyro covers every frame");
+  }
+}
+
+void StabilizerRos::DiagExtrinsics(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const WrapperStatus w = wrapper_->Status();
+  using E = ExtrinsicsState;
+  const std::string tf = "TF " + w.extrinsics_from + " -> " + w.extrinsics_to;
+  s.add("imu frame", w.extrinsics_from);
+  s.add("camera frame", w.extrinsics_to);
+  switch (w.extrinsics) {
+    case E::kConfigured:
+      s.summary(diagnostic_msgs::DiagnosticStatus::OK, "from imu/R_cam_imu");
+      break;
+    case E::kWaitingForImu:
+      s.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for the first IMU message");
+      break;
+    case E::kSameFrame:
+      s.summary(diagnostic_msgs::DiagnosticStatus::OK, "IMU and camera share a frame");
+      break;
+    case E::kWaitingForTf:
+      s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                "no " + tf + " yet: using imu/R_cam_imu until it comes");
+      break;
+    case E::kFromTf:
+      s.summary(diagnostic_msgs::DiagnosticStatus::OK, "from " + tf);
+      break;
   }
 }
 

@@ -182,19 +182,7 @@ bool StabilizerWrapper::EnsurePipeline(const sensor_msgs::CameraInfo& info,
     status_.last_error = s.message();
     return false;
   }
-  steadiface::PipelineOptions o = options_;
-  if (wrapper_options_.imu_extrinsics_from_tf && extrinsic_lookup_ && !imu_frame_.empty() &&
-      imu_frame_ != frame_id && !extrinsic_resolved_) {
-    Eigen::Quaterniond q;
-    if (extrinsic_lookup_(imu_frame_, frame_id, &q)) {
-      o.imu.R_cam_imu = q;
-      options_.imu.R_cam_imu = q;
-      extrinsic_resolved_ = true;
-    } else {
-      sink_->Warn("extrinsics", "no TF from IMU frame '" + imu_frame_ + "' to camera frame '" +
-                                    frame_id + "' yet; using imu/R_cam_imu");
-    }
-  }
+  const steadiface::PipelineOptions& o = options_;
   std::unique_ptr<steadiface::Pipeline> p;
   s = steadiface::Pipeline::Create(k, o, &p);
   if (!s.ok()) {
@@ -208,6 +196,40 @@ bool StabilizerWrapper::EnsurePipeline(const sensor_msgs::CameraInfo& info,
   pipeline_info_ = info;
   scheduler_.ForgetLastFrame();
   return true;
+}
+
+void StabilizerWrapper::ResolveExtrinsics(const std::string& camera_frame) {
+  // Looked up on every frame until TF has it (a static TF may come late,
+  // the IMU's frame is known from its first message); then the pipeline is
+  // rebuilt with it, the recent gyro replayed in the new rotation.
+  if (!wrapper_options_.imu_extrinsics_from_tf || !extrinsic_lookup_ || extrinsic_resolved_) {
+    return;
+  }
+  if (imu_frame_.empty()) {
+    status_.extrinsics = ExtrinsicsState::kWaitingForImu;
+    return;
+  }
+  if (imu_frame_ == camera_frame) {
+    status_.extrinsics = ExtrinsicsState::kSameFrame;
+    return;
+  }
+  status_.extrinsics_from = imu_frame_;
+  status_.extrinsics_to = camera_frame;
+  Eigen::Quaterniond q;
+  if (!extrinsic_lookup_(imu_frame_, camera_frame, &q)) {
+    status_.extrinsics = ExtrinsicsState::kWaitingForTf;
+    sink_->Warn("extrinsics", "no TF from IMU frame '" + imu_frame_ + "' to camera frame '" +
+                                  camera_frame + "' yet; using imu/R_cam_imu until it comes");
+    return;
+  }
+  options_.imu.R_cam_imu = q;
+  extrinsic_resolved_ = true;
+  status_.extrinsics = ExtrinsicsState::kFromTf;
+  if (pipeline_) {
+    FinishHeld();
+    pipeline_.reset();
+    ++counters_.rebuilds;
+  }
 }
 
 void StabilizerWrapper::OnImage(const sensor_msgs::ImageConstPtr& image,
@@ -249,6 +271,7 @@ void StabilizerWrapper::Drain(const ros::Time& now, bool flush) {
     const std::string frame_id = wrapper_options_.camera_frame.empty()
                                      ? p.image->header.frame_id
                                      : wrapper_options_.camera_frame;
+    ResolveExtrinsics(frame_id);
     if (!EnsurePipeline(*p.info, frame_id)) {
       scheduler_.DropFront();
       continue;
@@ -375,7 +398,7 @@ void StabilizerWrapper::Publish(const Pending& p, const steadiface::PipelineFram
     lm_header.frame_id = camera_frame;
     PublishLandmarksAndState(p, frame, lm_header, extrapolated, started, published);
     PublishTransforms(frame, in_header, camera_frame, out_header);
-    PublishRvizExtras(frame, in_header, out_header);
+    PublishRvizExtras(frame, lm_header, out_header);
     if (sink_->WantsDebugImage()) PublishDebugImage(frame, input, in_header);
     UpdateStatus(frame, in_header);
   }
@@ -420,6 +443,11 @@ void StabilizerWrapper::PublishLandmarksAndState(const Pending& p,
   sink_->PublishState(state);
 }
 
+std::string StabilizerWrapper::WorldFrame(const std::string& camera_frame) const {
+  return wrapper_options_.world_frame.empty() ? camera_frame + "_world"
+                                              : wrapper_options_.world_frame;
+}
+
 void StabilizerWrapper::PublishTransforms(const steadiface::PipelineFrame& frame,
                                           const std_msgs::Header& in_header,
                                           const std::string& camera_frame,
@@ -446,13 +474,16 @@ void StabilizerWrapper::PublishTransforms(const steadiface::PipelineFrame& frame
       if (brel.coeffs().allFinite()) tf.push_back(bt);
     }
     if (wrapper_options_.publish_world_tf) {
+      // The integrated gyro as a child of the camera frame, which keeps the
+      // parent its driver or URDF gives it: world coordinates -> camera
+      // coordinates, R_r.
       geometry_msgs::TransformStamped w;
       w.header.stamp = in_header.stamp;
-      w.header.frame_id = wrapper_options_.world_frame;
-      w.child_frame_id = camera_frame;
-      const Eigen::Quaterniond q_wc = frame.stabilizer.R_r.conjugate().normalized();
-      w.transform = ToTransformMsg(q_wc);
-      if (q_wc.coeffs().allFinite()) tf.push_back(w);
+      w.header.frame_id = camera_frame;
+      w.child_frame_id = WorldFrame(camera_frame);
+      const Eigen::Quaterniond q_cw = frame.stabilizer.R_r.normalized();
+      w.transform = ToTransformMsg(q_cw);
+      if (q_cw.coeffs().allFinite()) tf.push_back(w);
     }
     sink_->PublishTf(tf);
     last_tf_stamp_ = in_header.stamp;
@@ -468,7 +499,7 @@ void StabilizerWrapper::PublishRvizExtras(const steadiface::PipelineFrame& frame
   frusta_.Add(frame.stabilizer.R_r.conjugate(), frame.stabilizer.R_v.conjugate());
   if (sink_->WantsMarkers()) {
     std_msgs::Header world_header = in_header;
-    world_header.frame_id = wrapper_options_.world_frame;
+    world_header.frame_id = WorldFrame(in_header.frame_id);  // (the camera frame)
     const visualization_msgs::MarkerArray m = frusta_.Make(
         world_header, pipeline_->camera_model().intrinsics(), frame.output_intrinsics);
     if (!m.markers.empty()) sink_->PublishMarkers(m);

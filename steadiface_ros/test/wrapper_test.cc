@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <set>
 
 #include <cv_bridge/cv_bridge.h>
 #include <gtest/gtest.h>
@@ -150,6 +152,102 @@ TEST(WrapperTest, CleanStreamIsStabilizedFrameByFrame) {
   }
   ASSERT_EQ(stamps.size(), TestStream().images.size());
   for (size_t i = 1; i < stamps.size(); ++i) EXPECT_GT(stamps[i], stamps[i - 1]);
+}
+
+// The TF tree stays a tree: the camera frame keeps the parent its driver or
+// URDF gives it (the node never publishes it as a child), every frame the
+// node publishes has one parent, and the integrated gyro hangs below the
+// camera as <camera_frame>_world, rotated by the state's real rotation.
+TEST(WrapperTest, TransformsNeverGiveTheCameraFrameAParent) {
+  Sink sink;
+  steadiface::PipelineOptions po = Options();
+  po.stabilizer.background_layer = true;
+  StabilizerWrapper w(po, WrapperOptions(), &sink);
+  Feed(&w, TestStream());
+  std::map<std::string, std::set<std::string>> parents;
+  for (const auto& t : sink.tf) parents[t.child_frame_id].insert(t.header.frame_id);
+  EXPECT_EQ(parents.count("cam"), 0u);
+  for (const auto& [child, p] : parents) EXPECT_EQ(p.size(), 1u) << child;
+  ASSERT_EQ(parents["cam_world"], std::set<std::string>{"cam"});
+  EXPECT_EQ(parents["cam_stabilized"], std::set<std::string>{"cam"});
+  EXPECT_EQ(parents["cam_stabilized_background"], std::set<std::string>{"cam"});
+  size_t k = 0;
+  for (const auto& t : sink.tf) {
+    if (t.child_frame_id != "cam_world") continue;
+    ASSERT_LT(k, sink.states.size());
+    const auto& a = t.transform.rotation;
+    const auto& b = sink.states[k++].real_rotation;
+    EXPECT_NEAR(std::abs(a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w), 1.0, 1e-9);
+  }
+  EXPECT_EQ(k, sink.states.size());
+  // A configured world frame is used as it is.
+  Sink named_sink;
+  WrapperOptions named;
+  named.world_frame = "gyro_world";
+  StabilizerWrapper n(Options(), named, &named_sink);
+  Feed(&n, TestStream(), 0, 5);
+  size_t found = 0;
+  for (const auto& t : named_sink.tf) found += t.child_frame_id == "gyro_world";
+  EXPECT_EQ(found, 5u);
+}
+
+// An IMU in its own frame, rotated 90 deg about the optical axis against
+// the camera, whose static TF comes late: until it comes the node warns
+// and uses imu/R_cam_imu (identity, wrong here); once TF has it, the
+// rotation is taken, the pipeline rebuilt once, and from then on the
+// frame-to-frame real rotation is that of an IMU in the camera's frame.
+TEST(WrapperTest, LateImuExtrinsicsAreTakenWhenTfHasThem) {
+  const Eigen::Quaterniond R_cam_imu(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  Stream rotated = TestStream();
+  for (auto& m : rotated.imu) {
+    const Eigen::Vector3d w_cam(m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
+    const Eigen::Vector3d w_imu = R_cam_imu.conjugate() * w_cam;
+    m.angular_velocity.x = w_imu.x();
+    m.angular_velocity.y = w_imu.y();
+    m.angular_velocity.z = w_imu.z();
+    m.header.frame_id = "imu";
+  }
+  int asked = 0;
+  size_t resolved_at = 0;  // states published when TF had it
+  std::string asked_from, asked_to;
+  Sink sink, truth_sink;
+  auto lookup = [&](const std::string& from, const std::string& to, Eigen::Quaterniond* q) {
+    asked_from = from, asked_to = to;
+    if (++asked <= 20) return false;  // the static TF is not there yet
+    resolved_at = sink.states.size();
+    *q = R_cam_imu;
+    return true;
+  };
+  StabilizerWrapper w(Options(), WrapperOptions(), &sink, lookup);
+  Feed(&w, rotated, 0, 10);
+  EXPECT_EQ(w.Status().extrinsics, ExtrinsicsState::kWaitingForTf);
+  EXPECT_GT(sink.warnings["extrinsics"], 0);
+  Feed(&w, rotated, 10);
+  EXPECT_EQ(w.Status().extrinsics, ExtrinsicsState::kFromTf);
+  EXPECT_EQ(asked, 21);  // asked on every frame until it came, then never again
+  EXPECT_EQ(asked_from, "imu");
+  EXPECT_EQ(asked_to, "cam");
+  EXPECT_EQ(w.Status().counters.rebuilds, 1u);
+  StabilizerWrapper truth(Options(), WrapperOptions(), &truth_sink);
+  Feed(&truth, TestStream());
+  ASSERT_EQ(sink.states.size(), truth_sink.states.size());
+  auto step = [](const Sink& s, size_t i) {
+    auto q = [&](size_t j) {
+      const auto& r = s.states[j].real_rotation;
+      return Eigen::Quaterniond(r.w, r.x, r.y, r.z);
+    };
+    return q(i) * q(i - 1).conjugate();
+  };
+  double before = 0.0, after = 0.0;
+  for (size_t i = 1; i < sink.states.size(); ++i) {
+    const double e = step(sink, i).angularDistance(step(truth_sink, i));
+    if (i >= 2 && i <= 8) before = std::max(before, e);
+    if (i > resolved_at) after = std::max(after, e);
+  }
+  EXPECT_GT(before, 1e-3);  // the identity mounting is visibly wrong
+  EXPECT_LT(after, 1e-9);
+  EXPECT_GT(resolved_at, 10u);
+  EXPECT_LT(resolved_at + 20, sink.states.size());
 }
 
 // A missing landmark model (a one-time install, not a rosdep key) leaves the

@@ -42,8 +42,11 @@ struct WrapperOptions {
   /// package://pkg/path or a plain path. Empty = camera_info messages only.
   /// A camera_info message, when there is one, wins.
   std::string camera_info_url;
+  /// How image_raw arrives: raw, or compressed (the image_transport plugin
+  /// when installed, else image_raw/compressed and the built-in decoder).
+  std::string image_transport = "raw";
   std::string stabilized_suffix = "_stabilized";
-  std::string world_frame = "steadiface_world";
+  std::string world_frame;
   bool publish_world_tf = true;
   /// Look up the IMU -> camera rotation in TF when the IMU frame differs.
   bool imu_extrinsics_from_tf = true;

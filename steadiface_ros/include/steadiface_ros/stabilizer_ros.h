@@ -90,6 +90,7 @@ class StabilizerRos : public OutputSink {
   void DiagFrames(diagnostic_updater::DiagnosticStatusWrapper& s);
   void DiagProtrusion(diagnostic_updater::DiagnosticStatusWrapper& s);
   void DiagGyroVideo(diagnostic_updater::DiagnosticStatusWrapper& s);
+  void DiagExtrinsics(diagnostic_updater::DiagnosticStatusWrapper& s);
 
   ros::NodeHandle nh_, pnh_;
   std::string name_;

@@ -89,6 +89,15 @@ struct WrapperCounters {
 };
 
 /// A snapshot for the diagnostics tasks.
+/// Where imu/R_cam_imu comes from (imu_extrinsics_from_tf).
+enum class ExtrinsicsState {
+  kConfigured,     ///< the parameter (imu_extrinsics_from_tf off, or no TF lookup)
+  kWaitingForImu,  ///< the IMU's frame is not known yet (no IMU message)
+  kSameFrame,      ///< IMU and camera share a frame: identity, no TF needed
+  kWaitingForTf,   ///< TF has no transform between them yet: the parameter meanwhile
+  kFromTf,         ///< taken from TF
+};
+
 struct WrapperStatus {
   WrapperCounters counters;
   bool pipeline_ready = false;
@@ -111,6 +120,9 @@ struct WrapperStatus {
   steadiface::GyroVideoCheckResult gyro_video_check;
   /// The clock offset correction applied on top of imu/time_offset [s].
   double imu_offset_applied_s = 0.0;
+  /// The IMU extrinsics' source, and the frames of their TF lookup.
+  ExtrinsicsState extrinsics = ExtrinsicsState::kConfigured;
+  std::string extrinsics_from, extrinsics_to;
 };
 
 /// The one object behind the nodelet, the node and the offline bag tool: it
@@ -187,6 +199,11 @@ class StabilizerWrapper {
   void PublishLandmarksAndState(const Pending& p, const steadiface::PipelineFrame& frame,
                                 const std_msgs::Header& lm_header, bool extrapolated,
                                 const ros::Time& started, const ros::Time& published);
+  // Takes imu/R_cam_imu from TF once it resolves (then rebuilds the
+  // pipeline); tried again on every frame until then.
+  void ResolveExtrinsics(const std::string& camera_frame);
+  // The integrated gyro's frame: world_frame, or <camera_frame>_world.
+  std::string WorldFrame(const std::string& camera_frame) const;
   void PublishTransforms(const steadiface::PipelineFrame& frame,
                          const std_msgs::Header& in_header, const std::string& camera_frame,
                          const std_msgs::Header& out_header);
