@@ -317,6 +317,7 @@ void ReadFace(Reader& r, steadiface::FaceTrackerOptions* f) {
   r.Num("face/max_spread_ratio", &f->max_spread_ratio);
   r.Num("face/max_jump", &f->max_jump);
   r.Num("face/min_appearance", &f->min_appearance);
+  r.Num("face/min_region_appearance", &f->min_region_appearance);
   r.Bool("face/estimate_head_pose", &f->estimate_head_pose);
 }
 

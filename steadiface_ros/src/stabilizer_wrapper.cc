@@ -170,8 +170,7 @@ void StabilizerWrapper::OnLandmarks(const steadiface::FaceLandmarks& msg) {
   last_external_stamp_ = msg.header.stamp;
 }
 
-bool StabilizerWrapper::EnsurePipeline(const sensor_msgs::CameraInfo& info,
-                                       const std::string& frame_id) {
+bool StabilizerWrapper::EnsurePipeline(const sensor_msgs::CameraInfo& info) {
   if (pipeline_ && SameGeometry(info, pipeline_info_)) return true;
   FinishHeld();  // published with the pipeline that processed it
   steadiface::CameraIntrinsics k;
@@ -272,7 +271,7 @@ void StabilizerWrapper::Drain(const ros::Time& now, bool flush) {
                                      ? p.image->header.frame_id
                                      : wrapper_options_.camera_frame;
     ResolveExtrinsics(frame_id);
-    if (!EnsurePipeline(*p.info, frame_id)) {
+    if (!EnsurePipeline(*p.info)) {
       scheduler_.DropFront();
       continue;
     }

@@ -67,6 +67,29 @@ cv::Rect2d Extent(const std::vector<Eigen::Vector2d>& p) {
   return cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
 }
 
+// Normalized cross-correlation of two equal-sized CV_32F patches; 0 where
+// either has no variance (a flat occluder).
+double Ncc(const cv::Mat& pa, const cv::Mat& pb) {
+  const cv::Mat a = pa - cv::mean(pa)[0];
+  const cv::Mat b = pb - cv::mean(pb)[0];
+  const double na = cv::norm(a), nb = cv::norm(b);
+  return na > 1e-6 && nb > 1e-6 ? a.dot(b) / (na * nb) : 0.0;
+}
+
+// The aligned patch's parts that a hand covers one after another (fractions
+// of its side; the eyes sit at 0.28/0.72 x 0.32, the mouth at 0.5 x 0.8).
+struct FaceRegion {
+  float x0, y0, x1, y1;
+};
+constexpr FaceRegion kFaceRegions[] = {{0.08f, 0.15f, 0.46f, 0.5f},   // right eye
+                                       {0.54f, 0.15f, 0.92f, 0.5f},   // left eye
+                                       {0.3f, 0.4f, 0.7f, 0.68f},     // nose
+                                       {0.25f, 0.66f, 0.75f, 0.95f}};  // mouth
+
+// Regions that differ by less than this from each other are not an
+// occlusion (blur and turns lower them all).
+constexpr double kRegionSpread = 0.35;
+
 bool AllFinite(const std::vector<Eigen::Vector2d>& p) {
   for (const auto& q : p) {
     if (!q.allFinite()) return false;
@@ -102,6 +125,8 @@ Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
     err << "face.max_jump must be in (0, 20], got " << o.max_jump;
   } else if (!(o.min_appearance >= -1.0 && o.min_appearance < 1.0)) {
     err << "face.min_appearance must be in [-1, 1), got " << o.min_appearance;
+  } else if (!(o.min_region_appearance >= -1.0 && o.min_region_appearance < 1.0)) {
+    err << "face.min_region_appearance must be in [-1, 1), got " << o.min_region_appearance;
   } else if (o.appearance_patch_px < 16 || o.appearance_patch_px > 256) {
     err << "face.appearance_patch_px must be in [16, 256], got " << o.appearance_patch_px;
   } else if (!(o.appearance_update_rate >= 0.0 && o.appearance_update_rate <= 1.0)) {
@@ -187,7 +212,7 @@ cv::Rect2d FaceTracker::BoxFromLandmarks(const std::vector<Eigen::Vector2d>& lm)
 
 bool FaceTracker::AlignedPatch(const cv::Mat& gray,
                                const std::vector<Eigen::Vector2d>& lm,
-                               cv::Mat* patch) const {
+                               cv::Mat* patch, cv::Mat* A_out) const {
   if (lm.size() != 68) return false;
   auto mean_of = [&lm](int a, int b) -> Eigen::Vector2d {
     Eigen::Vector2d c = Eigen::Vector2d::Zero();
@@ -210,6 +235,7 @@ bool FaceTracker::AlignedPatch(const cv::Mat& gray,
                                         options_.appearance_patch_px),
                  cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
   u8.convertTo(*patch, CV_32F);
+  if (A_out != nullptr) *A_out = A;
   return true;
 }
 
@@ -302,16 +328,20 @@ FaceFailure FaceTracker::CheckAppearance(const cv::Mat& gray, const Candidate& c
                                          int* n_scores) const {
   // The normalized correlation of the aligned patch with the locked face's
   // (not at acquisition); a passing check adds its score.
+  // Each region (eyes, nose, mouth) is checked too: a hand over part of the
+  // face leaves the whole patch's correlation passable while the landmarks
+  // follow the hand; the covered region's correlation collapses.
   FaceFailure fail = FaceFailure::kNone;
-  if (!AlignedPatch(gray, c.landmarks, patch)) {
+  cv::Mat A;
+  if (!AlignedPatch(gray, c.landmarks, patch, &A)) {
     fail = FaceFailure::kImplausibleShape;
   } else if (!acquiring && !reference_patch_.empty()) {
-    cv::Mat a = *patch - cv::mean(*patch)[0];
-    cv::Mat b = reference_patch_ - cv::mean(reference_patch_)[0];
-    const double na = cv::norm(a), nb = cv::norm(b);
-    info->appearance = na > 1e-6 && nb > 1e-6 ? a.dot(b) / (na * nb) : 0.0;
+    info->appearance = Ncc(*patch, reference_patch_);
+    info->region_appearance = RegionAppearance(*patch, A, gray.size());
     if (info->appearance < options_.min_appearance) {
       fail = FaceFailure::kAppearance;
+    } else if (info->region_appearance < options_.min_region_appearance) {
+      fail = FaceFailure::kOccluded;
     } else {
       *score_sum +=
           (info->appearance - options_.min_appearance) / (1.0 - options_.min_appearance);
@@ -319,8 +349,38 @@ FaceFailure FaceTracker::CheckAppearance(const cv::Mat& gray, const Candidate& c
     }
   } else {
     info->appearance = 1.0;
+    info->region_appearance = 1.0;
   }
   return fail;
+}
+
+double FaceTracker::RegionAppearance(const cv::Mat& patch, const cv::Mat& A,
+                                     const cv::Size& image) const {
+  // The lowest correlation of the regions with the locked face's, over the
+  // regions wholly inside the image (one beyond its edge is not seen, not
+  // covered); 1 when none is, and 1 when the regions agree with each other
+  // within kRegionSpread: a blurred or turned face lowers them all, an
+  // occluder one or two.
+  cv::Mat Ai;
+  cv::invertAffineTransform(A, Ai);
+  const float P = static_cast<float>(patch.cols);
+  double lowest = 1.0, highest = -1.0;
+  for (const FaceRegion& r : kFaceRegions) {
+    const cv::Rect rc(cv::Point(static_cast<int>(r.x0 * P), static_cast<int>(r.y0 * P)),
+                      cv::Point(static_cast<int>(r.x1 * P), static_cast<int>(r.y1 * P)));
+    bool inside = true;
+    for (const cv::Point& q : {rc.tl(), rc.br(), cv::Point(rc.x, rc.br().y),
+                               cv::Point(rc.br().x, rc.y)}) {
+      const double x = Ai.at<double>(0, 0) * q.x + Ai.at<double>(0, 1) * q.y + Ai.at<double>(0, 2);
+      const double y = Ai.at<double>(1, 0) * q.x + Ai.at<double>(1, 1) * q.y + Ai.at<double>(1, 2);
+      inside = inside && x >= 0.0 && y >= 0.0 && x <= image.width - 1.0 && y <= image.height - 1.0;
+    }
+    if (!inside) continue;
+    const double ncc = Ncc(patch(rc), reference_patch_(rc));
+    lowest = std::min(lowest, ncc);
+    highest = std::max(highest, ncc);
+  }
+  return highest - lowest > kRegionSpread ? lowest : 1.0;
 }
 
 void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,

@@ -28,6 +28,8 @@ const char* FaceFailureName(FaceFailure f) {
       return "jump";
     case FaceFailure::kAppearance:
       return "appearance";
+    case FaceFailure::kOccluded:
+      return "occluded";
     case FaceFailure::kOutOfFrame:
       return "out_of_frame";
     case FaceFailure::kBadInput:

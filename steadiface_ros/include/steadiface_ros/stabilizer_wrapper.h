@@ -179,7 +179,7 @@ class StabilizerWrapper {
   };
   void Drain(const ros::Time& now, bool flush);
   void Process(const Pending& p, bool late);
-  bool EnsurePipeline(const sensor_msgs::CameraInfo& info, const std::string& frame_id);
+  bool EnsurePipeline(const sensor_msgs::CameraInfo& info);
   void ResetAll(const char* why);
   void ApplyPendingOptions();
   // `started`: the sink's clock when processing began (latency parts).

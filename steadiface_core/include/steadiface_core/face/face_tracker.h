@@ -52,6 +52,10 @@ struct FaceTrackerOptions {
   /// Min normalized cross-correlation of the aligned face patch with the
   /// locked face's [-].
   double min_appearance = 0.45;
+  /// Min normalized cross-correlation of each region of the aligned patch
+  /// (eyes, nose, mouth) with the locked face's: below it the face is
+  /// partly occluded and not used [-].
+  double min_region_appearance = 0.5;
   /// Side of the aligned face patch for the appearance check [px].
   int appearance_patch_px = 40;
   /// How fast the reference patch follows the face while tracking [0-1].
@@ -129,8 +133,13 @@ class FaceTracker {
                         const RowTiming* timing,
                         std::vector<Eigen::Vector2d>* predicted) const;
   cv::Rect2d BoxFromLandmarks(const std::vector<Eigen::Vector2d>& lm) const;
+  // CheckAppearance's per-region correlation (eyes, nose, mouth), `A` the
+  // patch's affine map from the image of `image` size.
+  double RegionAppearance(const cv::Mat& patch, const cv::Mat& A, const cv::Size& image) const;
+  // The face patch aligned on the eyes and mouth; `A` (optional) gets the
+  // image -> patch affine map (2x3, CV_64F).
   bool AlignedPatch(const cv::Mat& gray, const std::vector<Eigen::Vector2d>& lm,
-                    cv::Mat* patch) const;
+                    cv::Mat* patch, cv::Mat* A = nullptr) const;
   bool DetectAndFit(const cv::Mat& gray, const cv::Rect& roi,
                     const cv::Rect2d* near, Candidate* c, double* detect_ms);
   void MarkFailure(FaceFailure f, Time stamp, FaceInfo* info);

@@ -32,6 +32,8 @@ enum class FaceFailure {
   kSpreadMismatch,    ///< landmarks' extent disagrees with the box
   kJump,              ///< centre jumped away from the gyro prediction
   kAppearance,        ///< face patch no longer looks like the locked face
+  kOccluded,          ///< a region of the face patch (eyes, nose, mouth) does
+                      ///< not: partly covered
   kOutOfFrame,        ///< the predicted box left the image
   kBadInput,          ///< empty / tiny / non-8-bit image, or bad landmarks
   kNotSearched,       ///< searching, but no full-frame detection this frame
@@ -75,6 +77,7 @@ struct FaceInfo {
   double spread_ratio = 0.0;     ///< landmark extent / box size
   double jump = 0.0;             ///< |C - predicted C| / face scale
   double appearance = 0.0;       ///< NCC of the aligned face patch
+  double region_appearance = 0.0;  ///< the lowest NCC of its regions (eyes, nose, mouth)
   /// Head pose from solvePnP against the generic 3D face [rad].
   bool has_pose = false;
   double yaw = 0.0, pitch = 0.0, roll = 0.0;
