@@ -205,6 +205,25 @@ TEST(SimulatorTest, TruthLayersAreTheFrameWithoutTheSubjectAndItsCoverage) {
   EXPECT_EQ(cv::norm(alpha_a, alpha_b, cv::NORM_INF), 0.0);
 }
 
+// The robot preset is its own camera (640x480, 60 deg) whatever size is
+// asked for, with the person 2.5 m away: a face 30-40 px wide, the size a
+// robot's camera sees.
+TEST(SimulatorTest, RobotPresetSeesASmallFace) {
+  auto s = MakeSimulator("robot");
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s->intrinsics().width, 640);
+  EXPECT_EQ(s->intrinsics().height, 480);
+  EXPECT_NEAR(s->intrinsics().fx, 320.0 / std::tan(M_PI / 6.0), 1e-6);
+  for (int i : {0, 45, 89}) {
+    cv::Mat frame;
+    sim::SimTruth t;
+    s->Render(i, &frame, &t);
+    EXPECT_TRUE(t.head_in_view) << i;
+    EXPECT_GT(t.face_scale_px, 28.0) << i;
+    EXPECT_LT(t.face_scale_px, 40.0) << i;
+  }
+}
+
 TEST(SimulatorTest, PresetsAndErrors) {
   for (const auto& p : sim::PresetNames()) {
     auto s = MakeSimulator(p);
