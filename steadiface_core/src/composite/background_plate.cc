@@ -218,12 +218,6 @@ void BackgroundPlate::UpdateRow(const cv::Mat& image, const cv::Mat& matte, int 
   }
 }
 
-float BackgroundPlate::SampleAt(double x, double y, uchar* colour) const {
-  // The plate pixel the view pixel (x, y) shows.
-  const Eigen::Vector3d q = view_to_plate_ * Eigen::Vector3d(x, y, 1.0);
-  return SamplePlate(q.x() / q.z(), q.y() / q.z(), colour);
-}
-
 float BackgroundPlate::SamplePlate(double px, double py, uchar* colour) const {
   // Bilinear; fresh only where all four plate pixels are.
   if (!(px >= 0.0 && py >= 0.0 && px < plate_.cols - 1.0 && py < plate_.rows - 1.0)) return 0.0f;

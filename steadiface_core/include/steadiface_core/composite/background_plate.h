@@ -62,12 +62,10 @@ class BackgroundPlate {
   void Sample(const cv::Rect& roi, cv::Mat* colour, cv::Mat* valid) const;
   /// The same at `scale` pictures' pixels per output pixel (< 1: smaller).
   void Sample(const cv::Rect& roi, double scale, cv::Mat* colour, cv::Mat* valid) const;
-  /// The plate at output pixel (x, y) of the current view, bilinear, into
-  /// `colour` (the images' channels); returns its freshness in [0, 1] (0:
-  /// not seen, expired or outside; then `colour` is not written).
-  float SampleAt(double x, double y, uchar* colour) const;
-  /// The same at plate pixel (px, py); view_to_plate() maps output pixels
-  /// of the current view to plate pixels.
+  /// The plate at plate pixel (px, py), bilinear, into `colour` (the
+  /// images' channels); returns its freshness in [0, 1] (0: not seen,
+  /// expired or outside; then `colour` is not written). view_to_plate()
+  /// maps output pixels of the current view to plate pixels.
   float SamplePlate(double px, double py, uchar* colour) const;
   const Eigen::Matrix3d& view_to_plate() const { return view_to_plate_; }
   /// Takes this frame's background (`image_roi`, 8-bit, 1-4 channels, output rectangle
