@@ -128,7 +128,7 @@ std::string StabilizerRos::Subscribe(bool* builtin_compressed_out) {
   // Debian 12 ships no compressed_image_transport plugin: without it,
   // "compressed" subscribes to image_raw/compressed and decodes with the
   // built-in jpeg/png decoder.
-  std::string transport = wrapper_options_.image_transport;
+  const std::string& transport = wrapper_options_.image_transport;
   bool plugin = transport == "raw";
   for (const std::string& t : it_->getLoadableTransports()) {
     plugin = plugin || t == transport || t == "image_transport/" + transport;

@@ -88,7 +88,6 @@ struct WrapperCounters {
   uint64_t tf_skipped = 0;              ///< TF not newer than the last one
 };
 
-/// A snapshot for the diagnostics tasks.
 /// Where imu/R_cam_imu comes from (imu_extrinsics_from_tf).
 enum class ExtrinsicsState {
   kConfigured,     ///< the parameter (imu_extrinsics_from_tf off, or no TF lookup)
@@ -98,6 +97,7 @@ enum class ExtrinsicsState {
   kFromTf,         ///< taken from TF
 };
 
+/// A snapshot for the diagnostics tasks.
 struct WrapperStatus {
   WrapperCounters counters;
   bool pipeline_ready = false;
