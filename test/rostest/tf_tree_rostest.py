@@ -25,16 +25,9 @@ from geometry_msgs.msg import TransformStamped
 from sensor_msgs.msg import Image
 from tf2_msgs.msg import TFMessage
 
+from stabilizer_rostest import wait_for
+
 ARGS = None
-
-
-def wait_for(pred, timeout):
-    end = time.time() + timeout
-    while time.time() < end and not rospy.is_shutdown():
-        if pred():
-            return True
-        time.sleep(0.05)
-    return pred()
 
 
 class Watch(object):
