@@ -1,8 +1,13 @@
 // Face information extraction: ms/frame in tracking mode (gyro-predicted box,
 // landmarks, checks, head pose) and in detection mode (full-frame
 // detection + landmarks), on a rendered frame with the astronaut portrait
-// as a billboard 0.45 m away, at 640x360, 1280x720 and 1920x1080.
+// as a billboard 0.45 m away, at 640x360, 1280x720 and 1920x1080; and a
+// robot's view (640x480, 60 deg): the face 2.75 m away, 30 px wide, tracked,
+// and the search with nobody in view, with and without the small-face tiles.
 #include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -17,21 +22,24 @@ struct Scene {
   cv::Mat frame;
 };
 
-Scene Make(int w, int h) {
+// `distance_m` < 0: no face.
+Scene Make(int w, int h, double hfov = 1.0, double distance_m = 0.45) {
   Scene s;
-  CameraModel::Create(IntrinsicsFromHorizontalFov(w, h, 1.0), CameraModelOptions(), &s.model);
+  CameraModel::Create(IntrinsicsFromHorizontalFov(w, h, hfov), CameraModelOptions(), &s.model);
   const std::string data = STEADIFACE_TEST_DATA_DIR;
   const cv::Mat photo = cv::imread(data + "/astronaut.png");
   const sim::InfiniteBackground bg(cv::imread(data + "/building.jpg"), 600.0 * w / 640.0);
   sim::Billboard face =
       sim::MakeFaceBillboard(photo, cv::Rect(139, 38, 168, 188), 168 * 0.15 / 88.0);
-  face.pose = [](double) {
+  face.pose = [distance_m](double) {
     sim::Pose P;
-    P.p = Eigen::Vector3d(0.02, 0.0, 0.45);
+    P.p = Eigen::Vector3d(0.02 * distance_m / 0.45, 0.0, distance_m);
     return P;
   };
+  std::vector<const sim::Billboard*> boards;
+  if (distance_m > 0.0) boards.push_back(&face);
   sim::RenderScene(s.model.intrinsics(), [](double) { return 0.0; },
-                   [](double) { return sim::Pose(); }, bg, {&face}, h, &s.frame);
+                   [](double) { return sim::Pose(); }, bg, boards, h, &s.frame);
   return s;
 }
 
@@ -97,7 +105,68 @@ void BM_FaceTrackingWithRedetection(benchmark::State& state) {
   state.counters["valid"] = fi.valid;
 }
 
+// The robot's view: a 30 px face, tracked with the default re-detection
+// (upsampled near the face) and landmarks on an upsampled crop.
+void BM_SmallFaceTracking(benchmark::State& state) {
+  const Scene s = Make(640, 480, M_PI / 3.0, 2.75);
+  std::unique_ptr<FaceTracker> t;
+  const Status st = FaceTracker::Create(s.model, FaceTrackerOptions(), &t);
+  if (!st.ok() || s.frame.empty()) {
+    state.SkipWithError(st.ok() ? "no test frame" : st.message().c_str());
+    return;
+  }
+  FaceInfo fi;
+  double time = 1.0;
+  for (int i = 0; i < 10 && !fi.valid; ++i, time += 1.0 / 30) {  // acquire
+    t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
+  }
+  if (!fi.valid) {
+    state.SkipWithError("the 30 px face was not acquired");
+    return;
+  }
+  int valid = 0, n = 0;
+  for (auto _ : state) {
+    time += 1.0 / 30;
+    t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
+    valid += fi.valid ? 1 : 0;
+    ++n;
+  }
+  state.counters["face_px"] = fi.valid ? fi.box.width : 0.0;
+  state.counters["valid"] = static_cast<double>(valid) / std::max(1, n);
+}
+
+// Nobody in view at 30 fps: the mean cost per frame of the search (the
+// whole frame every 0.1 s, a small-face tile half-way between); min_face:0
+// is the tracker's default (30 px), 80 drops the tiles.
+void BM_SearchWithNobodyInView(benchmark::State& state) {
+  const Scene s = Make(state.range(0), state.range(1), M_PI / 3.0, -1.0);
+  FaceTrackerOptions o;
+  if (state.range(2) > 0) o.detector.min_face_px = static_cast<int>(state.range(2));
+  std::unique_ptr<FaceTracker> t;
+  const Status st = FaceTracker::Create(s.model, o, &t);
+  if (!st.ok() || s.frame.empty()) {
+    state.SkipWithError(st.ok() ? "no test frame" : st.message().c_str());
+    return;
+  }
+  FaceInfo fi;
+  double time = 1.0, worst = 0.0;
+  for (auto _ : state) {
+    time += 1.0 / 30;
+    t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
+    worst = std::max(worst, fi.timings.total_ms);
+  }
+  state.counters["worst_ms"] = worst;
+}
+
 BENCHMARK(BM_FaceTracking)->Apply(Args);
+BENCHMARK(BM_SmallFaceTracking)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SearchWithNobodyInView)
+    ->Args({640, 480, 0})
+    ->Args({640, 480, 80})
+    ->Args({1280, 720, 0})
+    ->Args({1280, 720, 160})
+    ->ArgNames({"w", "h", "min_face"})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FaceTrackingWithRedetection)->Apply(Args);
 BENCHMARK(BM_FaceDetectionMode)->Apply(Args);
 

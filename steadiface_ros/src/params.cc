@@ -310,6 +310,7 @@ void ReadFace(Reader& r, steadiface::FaceTrackerOptions* f) {
   r.Int("face/redetect_every", &f->redetect_every_frames);
   r.Num("face/redetect_region_scale", &f->redetect_region_scale);
   r.Int("face/redetect_face_px", &f->redetect_face_px);
+  r.Int("face/small_face_fit_px", &f->small_face_fit_px);
   r.Num("face/lost_timeout", &f->lost_timeout_s);
   r.Num("face/search_interval", &f->search_interval_s);
   r.Num("face/max_shape_residual", &f->max_shape_residual);

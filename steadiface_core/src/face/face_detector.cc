@@ -16,15 +16,23 @@
 namespace steadiface {
 namespace {
 
-// Downscales `roi` of `gray` so its longest side is <= max_side; returns
-// the scale factor applied (<= 1).
-double Downscale(const cv::Mat& gray, const cv::Rect& roi, int max_side,
-                 cv::Mat* out) {
-  const int longest = std::max(roi.width, roi.height);
-  const double s = longest > max_side ? static_cast<double>(max_side) / longest
-                                      : 1.0;
+// Detector boxes down to this fraction of min_face_px are kept.
+constexpr double kBoxTolerance = 0.8;
+
+// The copy of `roi` of `gray` the detector sees: scaled by `scale` if it
+// is > 0 (area-averaged down, bilinear up), else shrunk so its longest
+// side is <= max_side. Returns the scale applied.
+double ScaledCopy(const cv::Mat& gray, const cv::Rect& roi, double scale, int max_side,
+                  cv::Mat* out) {
+  double s = scale;
+  if (!(s > 0.0)) {
+    const int longest = std::max(roi.width, roi.height);
+    s = longest > max_side ? static_cast<double>(max_side) / longest : 1.0;
+  }
   if (s < 1.0) {
     cv::resize(gray(roi), *out, cv::Size(), s, s, cv::INTER_AREA);
+  } else if (s > 1.0) {
+    cv::resize(gray(roi), *out, cv::Size(), s, s, cv::INTER_LINEAR);
   } else {
     *out = gray(roi);
   }
@@ -98,13 +106,12 @@ class DlibHogDetector : public FaceDetector {
       : options_(o), detector_(LoadFrontalFaceDetector(DefaultModelCacheDir())) {}
 
   Status Detect(const cv::Mat& gray, const cv::Rect& roi,
-                std::vector<FaceBox>* faces, int max_side_px) override {
+                std::vector<FaceBox>* faces, double scale) override {
     faces->clear();
     Status st = CheckInput(gray, roi);
     if (!st.ok()) return st;
     cv::Mat small;
-    const double s = Downscale(
-        gray, roi, max_side_px > 0 ? max_side_px : options_.max_side_px, &small);
+    const double s = ScaledCopy(gray, roi, scale, options_.max_side_px, &small);
     if (small.cols < 40 || small.rows < 40) return Status::Ok();
     if (!small.isContinuous()) small = small.clone();
     dlib::cv_image<unsigned char> img(small);
@@ -116,11 +123,16 @@ class DlibHogDetector : public FaceDetector {
       f.rect = cv::Rect2d(roi.x + r.left() / s, roi.y + r.top() / s,
                           r.width() / s, r.height() / s);
       f.score = d.detection_confidence;
-      if (f.rect.width >= options_.min_face_px) faces->push_back(f);
+      // A box is a rough measure of the face (+-10 %): keep those that may
+      // be min_face_px wide.
+      if (f.rect.width >= kBoxTolerance * options_.min_face_px) faces->push_back(f);
     }
     SortLargestFirst(faces);
     return Status::Ok();
   }
+
+  // dlib's HOG window is 80 px square; its boxes come out from ~70 px.
+  double window_px() const override { return 75.0; }
 
  private:
   const FaceDetectorOptions options_;
@@ -133,13 +145,12 @@ class CascadeDetector : public FaceDetector {
   bool Load() { return cascade_.load(options_.cascade_path); }
 
   Status Detect(const cv::Mat& gray, const cv::Rect& roi,
-                std::vector<FaceBox>* faces, int max_side_px) override {
+                std::vector<FaceBox>* faces, double scale) override {
     faces->clear();
     Status st = CheckInput(gray, roi);
     if (!st.ok()) return st;
     cv::Mat small;
-    const double s = Downscale(
-        gray, roi, max_side_px > 0 ? max_side_px : options_.max_side_px, &small);
+    const double s = ScaledCopy(gray, roi, scale, options_.max_side_px, &small);
     std::vector<cv::Rect> rects;
     std::vector<int> neighbours;
     const int min_px = std::max(20, static_cast<int>(options_.min_face_px * s));
@@ -155,6 +166,9 @@ class CascadeDetector : public FaceDetector {
     SortLargestFirst(faces);
     return Status::Ok();
   }
+
+  // The frontal cascades' windows are 20-24 px.
+  double window_px() const override { return 24.0; }
 
  private:
   const FaceDetectorOptions options_;

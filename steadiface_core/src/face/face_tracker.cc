@@ -10,6 +10,7 @@
 #include "steadiface_core/camera/lens_distortion.h"
 #include "steadiface_core/common/grey.h"
 #include "steadiface_core/face/head_pose.h"
+#include "steadiface_core/face/upsampled_fit.h"
 
 namespace steadiface {
 namespace {
@@ -88,6 +89,8 @@ Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
         << o.redetect_region_scale;
   } else if (o.redetect_face_px < 60 || o.redetect_face_px > 1000) {
     err << "face.redetect_face_px must be in [60, 1000], got " << o.redetect_face_px;
+  } else if (o.small_face_fit_px < 0 || o.small_face_fit_px > 1000) {
+    err << "face.small_face_fit_px must be in [0, 1000], got " << o.small_face_fit_px;
   } else if (!(o.lost_timeout_s >= 0.0 && o.lost_timeout_s <= 60.0)) {
     err << "face.lost_timeout must be in [0, 60] s, got " << o.lost_timeout_s;
   } else if (!(o.search_interval_s >= 0.0 && o.search_interval_s <= 10.0)) {
@@ -125,6 +128,12 @@ Status FaceTracker::Create(const CameraModel& model,
   s = LandmarkPredictor::Load(options.landmark_model_path, &t->predictor_);
   if (!s.ok()) return s;
   t->head_model_ = BuildHeadModel(t->predictor_->MeanShape());
+  const CameraIntrinsics& k = model.intrinsics();
+  t->schedule_.reset(new SearchSchedule(cv::Size(k.width, k.height),
+                                        options.detector.max_side_px,
+                                        t->detector_->window_px(),
+                                        options.detector.min_face_px,
+                                        options.search_interval_s));
   *out = std::move(t);
   return Status::Ok();
 }
@@ -135,6 +144,7 @@ FaceTracker::FaceTracker(const CameraModel& model,
 
 void FaceTracker::reset() {
   state_ = TrackingState::kSearching;
+  if (schedule_) schedule_->Restart();
   last_landmarks_.clear();
   reference_shape_.clear();
   reference_patch_.release();
@@ -142,7 +152,6 @@ void FaceTracker::reset() {
   frames_since_detect_ = 0;
   frames_tracked_ = 0;
   force_detect_ = true;
-  have_last_search_ = false;
 }
 
 Eigen::Quaterniond FaceTracker::MidRotation(Time stamp,
@@ -333,17 +342,27 @@ bool FaceTracker::DetectAndFit(const cv::Mat& gray, const cv::Rect& roi,
                                double* detect_ms) {
   const auto t0 = Clock::now();
   std::vector<FaceBox> faces;
-  int max_side = 0;
+  // Scale so the expected face is ~redetect_face_px wide: down in whole
+  // pixels of the copy's longest side, or up for a small face (at most so
+  // far that the smallest face searched for fills the detector's window).
+  const int longest = std::max(roi.width, roi.height);
+  auto down = [&](double side) {
+    return side < longest ? static_cast<int>(side) / static_cast<double>(longest) : 1.0;
+  };
+  double scale = 0.0;
   if (near != nullptr && near->width > 0) {
-    // Scale so the expected face is ~redetect_face_px wide.
-    const double scale = std::min(1.0, options_.redetect_face_px / near->width);
-    max_side = std::max(64, static_cast<int>(std::max(roi.width, roi.height) * scale));
+    scale = options_.redetect_face_px / near->width;
+    scale = scale < 1.0 ? down(std::max(64.0, longest * scale))
+                        : std::min(scale, std::max(1.0, detector_->window_px() /
+                                                            options_.detector.min_face_px));
   }
-  bool ok = detector_->Detect(gray, roi, &faces, max_side).ok();
-  if (ok && faces.empty() && max_side > 0) {
+  bool ok = detector_->Detect(gray, roi, &faces, scale).ok();
+  if (ok && faces.empty() && scale > 0.0) {
     // A second scale near the expected face: blur and rolling-shutter skew
     // defeat the HOG detector at one scale more often than at two.
-    ok = detector_->Detect(gray, roi, &faces, static_cast<int>(max_side * 1.6)).ok();
+    const double second =
+        scale < 1.0 ? down(std::floor(scale * longest + 0.5) * 1.6) : 1.6 * scale;
+    ok = detector_->Detect(gray, roi, &faces, second).ok();
   }
   *detect_ms += MsSince(t0);
   if (!ok || faces.empty()) return false;
@@ -364,7 +383,13 @@ bool FaceTracker::DetectAndFit(const cv::Mat& gray, const cv::Rect& roi,
   }
   c->box = best->rect;
   c->detected = true;
-  return predictor_->Predict(gray, c->box, &c->landmarks).ok();
+  return Fit(gray, c->box, &c->landmarks);
+}
+
+bool FaceTracker::Fit(const cv::Mat& gray, const cv::Rect2d& box,
+                      std::vector<Eigen::Vector2d>* landmarks) const {
+  return FitLandmarksUpsampled(*predictor_, gray, box, options_.small_face_fit_px, landmarks)
+      .ok();
 }
 
 Status FaceTracker::Process(const cv::Mat& image, Time stamp,
@@ -393,16 +418,13 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
       ToSeconds(stamp - last_seen_) > options_.lost_timeout_s) {
     reset();
   }
-  // While searching, the full-frame detection runs once per
-  // search_interval_s (1 ms of slack for frame-time jitter); a time jump
-  // backwards searches at once.
-  const bool search_due =
-      !have_last_search_ || stamp < last_search_ ||
-      ToSeconds(stamp - last_search_) >= options_.search_interval_s - 1e-3;
-  if (state_ == TrackingState::kSearching && !search_due) {
+  // While searching, the whole frame once per search_interval_s and a
+  // small-face tile in between (face/search_schedule.h).
+  SearchStep step;
+  if (state_ == TrackingState::kSearching && !schedule_->Due(stamp, &step)) {
     MarkFailure(FaceFailure::kNotSearched, stamp, info);
   } else if (state_ == TrackingState::kSearching) {
-    Search(gray, full, stamp, info);
+    Search(gray, step, stamp, info);
   } else {
     Track(gray, full, stamp, timeline, timing, rot_ok, info);
   }
@@ -418,17 +440,17 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
   return Status::Ok();
 }
 
-void FaceTracker::Search(const cv::Mat& gray, const cv::Rect& full, Time stamp, FaceInfo* info) {
-  // A full-frame detection; the largest face whose landmarks pass the
+void FaceTracker::Search(const cv::Mat& gray, const SearchStep& step, Time stamp,
+                         FaceInfo* info) {
+  // One step of the search schedule (the whole frame, or an upsampled
+  // tile for small faces); the largest face whose landmarks pass the
   // checks is locked.
   Candidate c;
   cv::Mat patch;
   bool ok = false;
-  have_last_search_ = true;
-  last_search_ = stamp;
   const auto t0 = Clock::now();
   std::vector<FaceBox> faces;
-  detector_->Detect(gray, full, &faces);
+  detector_->Detect(gray, step.roi, &faces, step.scale);
   info->timings.detect_ms += MsSince(t0);
   info->detected = true;
   for (const FaceBox& f : faces) {  // largest first
@@ -436,7 +458,7 @@ void FaceTracker::Search(const cv::Mat& gray, const cv::Rect& full, Time stamp, 
     c.box = f.rect;
     c.detected = true;
     const auto t1 = Clock::now();
-    const bool fit = predictor_->Predict(gray, c.box, &c.landmarks).ok();
+    const bool fit = Fit(gray, c.box, &c.landmarks);
     info->timings.landmarks_ms += MsSince(t1);
     if (fit && Evaluate(&gray, c, true, nullptr, info, &patch)) {
       ok = true;
@@ -491,7 +513,7 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
     c = Candidate();
     c.box = pbox;
     const auto t1 = Clock::now();
-    const bool fit = predictor_->Predict(gray, c.box, &c.landmarks).ok();
+    const bool fit = Fit(gray, c.box, &c.landmarks);
     info->timings.landmarks_ms += MsSince(t1);
     ok = fit && Evaluate(&gray, c, false, &pc, info, &patch);
     // Always re-detect after a failure.

@@ -28,8 +28,11 @@ struct FaceDetectorOptions {
   /// dlib HOG score threshold (higher = fewer false positives) [-]. At 0 the
   /// portrait test image gives large false positives scoring 0.03-0.23.
   double dlib_threshold = 0.3;
-  /// Minimum face size in full-resolution pixels [px].
-  int min_face_px = 40;
+  /// Smallest face to find, in full-resolution pixels [px]. The search
+  /// looks for faces this small in upsampled tiles (face/search_schedule.h);
+  /// detections narrower than 0.8 x this are dropped (a box measures a face
+  /// to about 10 %).
+  int min_face_px = 30;
 };
 
 Status ValidateFaceDetectorOptions(const FaceDetectorOptions& options);
@@ -40,10 +43,15 @@ class FaceDetector {
  public:
   virtual ~FaceDetector() = default;
   /// Detects faces in `roi` of the 8-bit grayscale `gray`; boxes are in
-  /// full-image pixels, largest first. `max_side_px` > 0 overrides the
-  /// downscale limit (re-detection around a known face uses a small copy).
+  /// full-image pixels, largest first. `scale` > 0 sets the scale of the
+  /// copy the detector sees, below 1 to shrink it, above 1 to find faces
+  /// smaller than the detector's window; 0 shrinks it so its longest side
+  /// is at most max_side_px.
   virtual Status Detect(const cv::Mat& gray, const cv::Rect& roi,
-                        std::vector<FaceBox>* faces, int max_side_px = 0) = 0;
+                        std::vector<FaceBox>* faces, double scale = 0.0) = 0;
+  /// The narrowest face box the detector finds in the copy it sees [px]:
+  /// faces narrower than this / scale are missed.
+  virtual double window_px() const = 0;
 
   static Status Create(const FaceDetectorOptions& options,
                        std::unique_ptr<FaceDetector>* out);

@@ -14,6 +14,7 @@
 #include "steadiface_core/face/face_detector.h"
 #include "steadiface_core/face/face_types.h"
 #include "steadiface_core/face/landmark_predictor.h"
+#include "steadiface_core/face/search_schedule.h"
 #include "steadiface_core/gyro/orientation_timeline.h"
 
 namespace steadiface {
@@ -28,17 +29,24 @@ struct FaceTrackerOptions {
   int redetect_every_frames = 15;
   /// The re-detection region is the predicted box enlarged by this [-].
   double redetect_region_scale = 2.2;
-  /// Re-detection near the face runs on a copy scaled so the face is about
-  /// this wide (dlib's HOG finds faces from ~80 px) [px].
+  /// Re-detection near the face runs on a copy scaled, down or up, so the
+  /// face is about this wide (dlib's HOG finds faces from ~75 px) [px].
   int redetect_face_px = 100;
+  /// Faces narrower than this are fitted on a crop upsampled so they are
+  /// this wide (face/upsampled_fit.h: a fifth closer to the full-size fit
+  /// at 24-40 px); 0: always at the image's size [px].
+  int small_face_fit_px = 60;
   /// Keep the lock on a lost face this long before re-acquiring the
   /// largest face anywhere [s].
   double lost_timeout_s = 1.0;
   /// With no face locked (searching), the full-frame detection runs at most
-  /// once per this interval [s]; frames in between report not_searched. A
-  /// full-frame search costs 20-25 ms at 720p (most of a 30 fps frame),
-  /// so searching every frame would stall a camera with nobody in view.
-  /// The first search after a loss or reset is immediate. 0: every frame.
+  /// once per this interval [s]; frames in between report not_searched,
+  /// except the one half an interval later, which searches one upsampled
+  /// tile for faces down to detector.min_face_px (face/search_schedule.h).
+  /// A full-frame search costs 14 ms (a tile about as much), most of a
+  /// 30 fps frame, so searching every frame would stall a camera with
+  /// nobody in view. The first search after a loss or reset is immediate.
+  /// 0: every frame, the whole frame and a tile in turn.
   double search_interval_s = 0.1;
   /// Shape plausibility: max RMS residual after similarity alignment to the
   /// locked face's shape, relative to the face scale [-].
@@ -108,7 +116,7 @@ class FaceTracker {
 
   // Process's two paths: a full-frame search while no face is locked, and
   // tracking the locked (or recently lost) face where the gyro puts it.
-  void Search(const cv::Mat& gray, const cv::Rect& full, Time stamp, FaceInfo* info);
+  void Search(const cv::Mat& gray, const SearchStep& step, Time stamp, FaceInfo* info);
   void Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
              const OrientationTimeline* timeline, const RowTiming* timing, bool rot_ok,
              FaceInfo* info);
@@ -140,6 +148,9 @@ class FaceTracker {
   // image -> patch affine map (2x3, CV_64F).
   bool AlignedPatch(const cv::Mat& gray, const std::vector<Eigen::Vector2d>& lm,
                     cv::Mat* patch, cv::Mat* A = nullptr) const;
+  // The 68 landmarks in `box` (upsampled when the face is small).
+  bool Fit(const cv::Mat& gray, const cv::Rect2d& box,
+           std::vector<Eigen::Vector2d>* landmarks) const;
   bool DetectAndFit(const cv::Mat& gray, const cv::Rect& roi,
                     const cv::Rect2d* near, Candidate* c, double* detect_ms);
   void MarkFailure(FaceFailure f, Time stamp, FaceInfo* info);
@@ -150,6 +161,7 @@ class FaceTracker {
   const FaceTrackerOptions options_;
   std::unique_ptr<FaceDetector> detector_;
   std::unique_ptr<LandmarkPredictor> predictor_;
+  std::unique_ptr<SearchSchedule> schedule_;  // where the next search looks
   std::vector<Eigen::Vector3d> head_model_;
 
   TrackingState state_ = TrackingState::kSearching;
@@ -164,9 +176,6 @@ class FaceTracker {
   int frames_since_detect_ = 0;
   int frames_tracked_ = 0;
   bool force_detect_ = true;
-  // The last full-frame search (search_interval_s), if any since reset().
-  bool have_last_search_ = false;
-  Time last_search_;
 };
 
 }  // namespace steadiface
