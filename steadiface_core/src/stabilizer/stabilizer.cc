@@ -288,10 +288,19 @@ void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* 
     }
     Eigen::Vector2d H_prev = layer.H_prev;
     if (!layer.has_H) {
-      // Start where the face appears in the virtual view now: no jump. (From
-      // the landmarks: f->C may already be in the predicted virtual view.)
+      // Start where the face appears in the virtual view now: no jump. With
+      // a history that is the view the virtual camera would show if it kept
+      // moving smoothly (f->C): R_v0 carries this frame's shake, so on a
+      // shaking camera a face found mid-sequence would start its target off
+      // by the shake of that one frame and hold the output there (robot
+      // preset: an 8 px step at the acquisition, now 1 px).
       FaceObservation seen;
-      H_prev = FaceInCamera(model_, *face, f->rows, f->R_r, R_v0, t0, &seen) ? seen.centre : f->C;
+      if (options_.smooth_head_in_virtual_view && layer.history > 0) {
+        H_prev = f->C;
+      } else {
+        H_prev = FaceInCamera(model_, *face, f->rows, f->R_r, R_v0, t0, &seen) ? seen.centre
+                                                                                 : f->C;
+      }
     }
     // Eq. 1's constraint |H - C| < r is a reachability bound when C is in
     // the real frame (the paper): a crop that moves by at most r can show
