@@ -163,6 +163,8 @@ int Usage() {
                "         trace: scale its rotation, or play it K times as fast)\n"
                "       [--search-interval S] (face.search_interval: full-frame face search\n"
                "         at most once per S while no face is locked; 0 = every frame)\n"
+               "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
+               "         shows a 30 px face)\n"
                "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
                "         widths of where the background layer shows the face)\n"
                "       [--reach-lowpass HZ] [--reach-hold F] (stabilizer.subject_reach_lowpass,\n"
@@ -267,6 +269,7 @@ int main(int argc, char** argv) {
   // The recorded trace's scale and playback speed (NaN: the preset's).
   double gyro_scale = NAN, gyro_speed = NAN;
   double search_interval = NAN;  // face.search_interval [s]; NaN: the default
+  double head_distance = NAN;    // the subject's distance [m]; NaN: the preset's
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
   double subject_reach = 0.0;    // stabilizer.subject_reach [jaw widths]; 0: off
@@ -287,6 +290,7 @@ int main(int argc, char** argv) {
   cl.Double("--crop", &crop).Double("--offset-error", &offset_error);
   cl.Double("--readout-error", &readout_error).Double("--gyro-scale", &gyro_scale);
   cl.Double("--gyro-speed", &gyro_speed).Double("--search-interval", &search_interval);
+  cl.Double("--head-distance", &head_distance);
   cl.Double("--head-w-stay", &head_w_stay).Double("--head-d-ref", &head_d_ref);
   cl.Double("--subject-reach", &subject_reach).Double("--reach-lowpass", &reach_lowpass);
   cl.Double("--reach-hold", &reach_hold).Flag("--feasible-set", &feasible_set);
@@ -390,6 +394,7 @@ int main(int argc, char** argv) {
     steadiface::Status s = steadiface::sim::ApplyPreset(preset, &so);
     if (std::isfinite(gyro_scale)) so.real_gyro_scale = gyro_scale;
     if (std::isfinite(gyro_speed)) so.real_gyro_speed = gyro_speed;
+    if (std::isfinite(head_distance)) so.head.distance_m = head_distance;
     std::unique_ptr<steadiface::sim::Simulator> sim;
     if (s.ok()) s = steadiface::sim::Simulator::Create(so, &sim);
     if (s.ok() && !std::isfinite(duration) && sim->real_gyro_span_s() > so.duration_s) {
@@ -504,6 +509,12 @@ int main(int argc, char** argv) {
         }
         if (s.ok() && !video) {
           sc = card->Compute();
+          // Frames whose face entered E_f: found, passed every check, used.
+          if (m != Method::kNone && m != Method::kGyroOnly && !stab_frames.empty()) {
+            int used = 0;
+            for (const auto& f : stab_frames) used += f.flags.face_used ? 1 : 0;
+            face_fraction = static_cast<double>(used) / stab_frames.size();
+          }
           for (const auto& st : sc.stage_ms) {
             if (st.first == "solver") solver = st.second.first;
             if (st.first == "face") face = st.second.first;

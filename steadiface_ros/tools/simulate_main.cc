@@ -42,8 +42,9 @@ int Usage() {
                "   recorded in IMU axes, so the stabilizer needs imu/R_cam_imu = its inverse]\n"
                "  [--calibration-out FILE.yaml: the camera's intrinsics as a camera_calibration\n"
                "   YAML, for camera_info_url]\n"
-               "presets: still walk pan run occlusion two_faces turn_away vlog shake drift\n"
-               "         walk_across bob hair passer_by\n";
+               "presets:";
+  for (const std::string& p : steadiface::sim::PresetNames()) std::cerr << " " << p;
+  std::cerr << "\n";
   return 2;
 }
 
