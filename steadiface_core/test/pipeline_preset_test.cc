@@ -220,6 +220,43 @@ TEST(PipelinePresetTest, ARobotsDistantFaceIsFoundAndTakenOverWithoutAStep) {
   EXPECT_EQ(full.undefined_fraction, 0.0);
 }
 
+// A camera without an IMU (rotation_source visual): the rotation comes from
+// the video. On pan and walk the background stays within 3x of what the
+// gyro gives (on walk well below the input's), and global mode holds the
+// head within 1.3x of the gyro-driven head.
+TEST(PipelinePresetTest, WithoutAnImuTheVideoGivesTheRotation) {
+  for (const std::string preset : {"pan", "walk"}) {
+    SCOPED_TRACE(preset);
+    auto s = MakeSimulator(preset);
+    eval::Score by[2][2];  // [visual][method: gyro-only, steadiface]
+    for (int visual = 0; visual < 2; ++visual) {
+      for (int k = 0; k < 2; ++k) {
+        const eval::Method method = k == 0 ? eval::Method::kGyroOnly : eval::Method::kSteadiface;
+        PipelineOptions po = eval::OptionsFor(*s, method);
+        if (visual) po.rotation_source = RotationSource::kVisual;
+        std::unique_ptr<eval::Scorecard> card;
+        ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
+        ASSERT_TRUE(eval::RunMethod(*s, method, po, false, card.get(), nullptr).ok());
+        by[visual][k] = card->Compute();
+      }
+    }
+    const PresetResult r = Score(preset);
+    std::cout << "[ " << preset << ", rotation from the video ] visible background, gyro-only: "
+              << by[1][0].visible_background_jitter_px << " px (gyro "
+              << by[0][0].visible_background_jitter_px << ", input "
+              << r.none.visible_background_jitter_px << "); head, global: "
+              << by[1][1].head_jitter_px << " px (gyro " << by[0][1].head_jitter_px << ")\n";
+    EXPECT_LE(by[1][0].visible_background_jitter_px, 3.0 * by[0][0].visible_background_jitter_px);
+    // (On pan the gyro itself keeps most of the input's jitter: it follows
+    // the pan.)
+    if (preset == "walk") {
+      EXPECT_LE(by[1][0].visible_background_jitter_px, 0.5 * r.none.visible_background_jitter_px);
+    }
+    EXPECT_LE(by[1][1].head_jitter_px, 1.3 * by[0][1].head_jitter_px);
+    EXPECT_EQ(by[1][1].undefined_fraction, 0.0);
+  }
+}
+
 TEST(PipelinePresetTest, EveryPresetHasNoUndefinedPixels) {
   for (const std::string& p : {"still", "pan", "occlusion", "two_faces", "turn_away"}) {
     const PresetResult r = Score(p);

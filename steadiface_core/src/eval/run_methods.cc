@@ -136,7 +136,8 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
   for (int i = 0; i < sim.num_frames(); ++i) {
     const Time stamp = sim.Truth(i).stamp;
     FeedGyroForFrame(sim, stamp, o.imu.imu_time_offset_s, p.get(), &g);
-    if (o.landmark_source == LandmarkSource::kDlib || o.render_output) {
+    if (o.landmark_source == LandmarkSource::kDlib || o.render_output ||
+        o.rotation_source == RotationSource::kVisual) {
       s = sim.Render(i, &frame, &truth);
       if (!s.ok()) return s;
     } else {

@@ -123,6 +123,25 @@ SampleResult OrientationTimeline::AddSample(const GyroSample& sample) {
   return result;
 }
 
+SampleResult OrientationTimeline::AddOrientation(Time t, const Eigen::Quaterniond& q_wc,
+                                                 const Eigen::Vector3d& omega) {
+  SampleResult result = SampleResult::kAccepted;
+  if (!omega.allFinite() || !q_wc.coeffs().allFinite() || q_wc.norm() < 0.5) {
+    result = SampleResult::kNonFinite;
+  } else if (omega.norm() > options_.max_angular_rate) {
+    result = SampleResult::kImplausibleRate;
+  } else if (!samples_.empty() && t == samples_.back().t) {
+    result = SampleResult::kDuplicateStamp;
+  } else if (!samples_.empty() && t < samples_.back().t) {
+    result = SampleResult::kOutOfOrder;
+  }
+  ++stats_.samples[static_cast<size_t>(result)];
+  if (result != SampleResult::kAccepted) return result;
+  samples_.push_back(Node{t, omega, q_wc.normalized()});
+  Trim();
+  return result;
+}
+
 void OrientationTimeline::Trim() {
   const Time horizon = samples_.back().t - buffer_duration_;
   while (samples_.size() > 2 &&

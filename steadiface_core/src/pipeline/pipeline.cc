@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "steadiface_core/common/grey.h"
+#include "steadiface_core/common/so3.h"
 #include "steadiface_core/warp/mesh_sampler.h"
 
 namespace steadiface {
@@ -12,6 +14,17 @@ namespace {
 double MsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t)
       .count();
+}
+
+// The timeline a stream integrates: the IMU's as configured, or with the
+// visual source camera-frame rates on the camera clock.
+OrientationTimelineOptions TimelineOptions(const PipelineOptions& o) {
+  if (o.rotation_source != RotationSource::kVisual) return o.imu;
+  OrientationTimelineOptions v = o.imu;
+  v.R_cam_imu = Eigen::Quaterniond::Identity();
+  v.gyro_bias = Eigen::Vector3d::Zero();
+  v.imu_time_offset_s = 0.0;
+  return v;
 }
 
 }  // namespace
@@ -33,6 +46,10 @@ Status ValidatePipelineOptions(const PipelineOptions& o) {
   if (!s.ok()) return s;
   s = ValidateCompositeOptions(o.composite);
   if (!s.ok()) return s;
+  if (o.rotation_source == RotationSource::kVisual) {
+    s = ValidateVisualRotationOptions(o.visual);
+    if (!s.ok()) return s;
+  }
   return ValidateWarpOptions(o.warp);
 }
 
@@ -40,7 +57,7 @@ Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
     : model_(model),
       options_(options),
       timing_(options.shutter, model.intrinsics().height),
-      timeline_(options.imu),
+      timeline_(TimelineOptions(options)),
       region_(new SubjectRegionTracker(options.warp.layered.region)) {}
 
 StabilizerOptions ForWarp(const StabilizerOptions& options, const WarpOptions& warp) {
@@ -88,7 +105,10 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
     s = Compositor::Create(p->warper_->output_geometry(), options.composite, &p->compositor_);
     if (!s.ok()) return s;
   }
-  if (options.gyro_video_check.enabled) {
+  if (options.rotation_source == RotationSource::kVisual) {
+    s = VisualRotationEstimator::Create(model, p->timing_, options.visual, &p->visual_);
+    if (!s.ok()) return s;
+  } else if (options.gyro_video_check.enabled) {
     s = GyroVideoCheck::Create(model.intrinsics(), p->timing_, options.imu.R_cam_imu.normalized(),
                                options.gyro_video_check, &p->check_);
     if (!s.ok()) return s;
@@ -98,10 +118,12 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
 }
 
 SampleResult Pipeline::AddGyro(const GyroSample& sample) {
+  if (visual_ != nullptr) return SampleResult::kAccepted;  // the video gives the rotation
   return timeline_.AddSample(sample);
 }
 
 bool Pipeline::GyroCovers(Time stamp) const {
+  if (visual_ != nullptr) return true;
   return timeline_.Covers(timing_.FirstRowTime(stamp)) &&
          timeline_.Covers(timing_.LastRowTime(stamp));
 }
@@ -117,13 +139,25 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
                          std::to_string(k.width) + "x" + std::to_string(k.height));
   }
   PipelineFrame f;
+  cv::Mat grey;
+  if (visual_ != nullptr) {
+    grey = ToGrey(image);
+    Status v = VisualStep(grey, stamp, &f);
+    if (!v.ok()) return v;
+  }
   // Face information.
   const auto t_face = std::chrono::steady_clock::now();
   FaceObservation observation;
-  cv::Mat grey;
   const FaceObservation* obs =
       FaceStep(image, stamp, external, external_confidence, &grey, &observation, &f);
   f.timings.face_ms = MsSince(t_face);
+  // The visual source leaves the subject out: the face found, or the lost
+  // one where it was last seen, until the tracker searches again.
+  if (f.face.valid) {
+    last_face_box_ = f.face.box;
+  } else if (f.face.state == TrackingState::kSearching) {
+    last_face_box_ = cv::Rect2d();
+  }
   // The gyro-vs-video check (never changes the pose), outside the face.
   if (check_ != nullptr) {
     const auto t_check = std::chrono::steady_clock::now();
@@ -164,7 +198,8 @@ const FaceObservation* Pipeline::FaceStep(const cv::Mat& image, Time stamp,
   // cv::cvtColor each would run, so their results do not change).
   const bool internal_face =
       tracker_ != nullptr && options_.landmark_source != LandmarkSource::kExternal;
-  *grey_out = internal_face ? ToGrey(image) : image;
+  // (The visual rotation source's grey, when it ran, is the same picture.)
+  if (grey_out->empty()) *grey_out = internal_face ? ToGrey(image) : image;
   const cv::Mat& grey = *grey_out;
   if (tracker_ != nullptr) {
     Status s;
@@ -356,8 +391,54 @@ Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered
   return Status::Ok();
 }
 
+Status Pipeline::VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f) {
+  Status s = visual_->Process(grey, stamp, last_face_box_, &f->visual);
+  if (!s.ok()) return s;
+  const double mid_row = 0.5 * (model_.intrinsics().height - 1);
+  const Time mid = timing_.RowTime(stamp, mid_row);
+  const Time first_row = timing_.FirstRowTime(stamp);
+  const Time last_row = timing_.LastRowTime(stamp);
+  // The first frame, or one that starts before the newest node (time ran
+  // back), starts the timeline afresh, the camera held still over it.
+  if (!timeline_.empty() && timeline_.newest() >= first_row) timeline_.reset();
+  if (timeline_.empty()) {
+    timeline_.AddOrientation(first_row - FromSeconds(1e-3), Eigen::Quaterniond::Identity(),
+                             Eigen::Vector3d::Zero());
+    timeline_.AddOrientation(last_row, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+    visual_mid_ = mid;
+    return Status::Ok();
+  }
+  // The rotation between the two frames' middle rows and across this
+  // frame's rows is the pair's (omega + alpha (t - stamp)), from the
+  // orientation at the previous frame's middle row: nodes every 2 ms from
+  // the newest (the previous frame's last row) to this frame's last row.
+  // The previous frame's rows keep the rotations they were given; the
+  // blanking between the frames takes up any difference. Not trusted: held
+  // still from the newest node.
+  const bool held = !f->visual.valid;
+  const Time anchor_t = held ? timeline_.newest() : visual_mid_;
+  Eigen::Quaterniond anchor = Eigen::Quaterniond::Identity();
+  if (!QuerySucceeded(timeline_.CameraToWorld(anchor_t, &anchor))) {
+    timeline_.CameraToWorld(timeline_.newest(), &anchor);
+  }
+  const double ta = ToSeconds(anchor_t - f->visual.stamp);
+  const Time from = timeline_.newest();
+  const int steps = std::max(1, static_cast<int>(std::ceil(ToSeconds(last_row - from) / 0.002)));
+  for (int k = 1; k <= steps; ++k) {
+    const Time t = from + (last_row - from) * k / steps;
+    const double u = ToSeconds(t - f->visual.stamp);
+    const Eigen::Vector3d phi =
+        f->visual.omega * (u - ta) + 0.5 * f->visual.alpha * (u * u - ta * ta);
+    const Eigen::Vector3d omega = f->visual.omega + f->visual.alpha * u;
+    timeline_.AddOrientation(t, anchor * ExpSO3(phi), omega);
+  }
+  visual_mid_ = mid;
+  return Status::Ok();
+}
+
 void Pipeline::Reset() {
   timeline_.reset();
+  if (visual_ != nullptr) visual_->Reset();
   if (tracker_ != nullptr) tracker_->reset();
   stabilizer_->reset();
   if (check_ != nullptr) check_->Reset();

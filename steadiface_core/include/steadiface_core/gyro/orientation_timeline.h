@@ -119,6 +119,13 @@ class OrientationTimeline {
   /// Transforms the sample to the camera frame and clock, validates it and
   /// integrates it. Rejections are counted in stats().
   SampleResult AddSample(const GyroSample& sample);
+  /// Appends an orientation known outright instead of integrating a rate:
+  /// q_wc in the timeline's world frame and the angular velocity there, both
+  /// camera frame, at camera-clock time t (no mounting, bias or offset
+  /// applied). Queries interpolate between nodes as ever. The visual
+  /// rotation source builds its timeline this way.
+  SampleResult AddOrientation(Time t, const Eigen::Quaterniond& q_wc,
+                              const Eigen::Vector3d& omega);
 
   /// Camera-to-world rotation q_wc at camera-clock time t.
   QueryResult CameraToWorld(Time t, Eigen::Quaterniond* q_wc) const;

@@ -14,6 +14,7 @@
 #include "steadiface_core/face/face_tracker.h"
 #include "steadiface_core/gyro/orientation_timeline.h"
 #include "steadiface_core/stabilizer/stabilizer.h"
+#include "steadiface_core/visual/visual_rotation.h"
 #include "steadiface_core/warp/warper.h"
 
 namespace steadiface {
@@ -23,6 +24,12 @@ enum class LandmarkSource {
   kDlib,      ///< the built-in detector + dlib 68-point tracker
   kExternal,  ///< landmarks supplied with each frame (another node)
   kNone,      ///< no face processing: gyro-only stabilization
+};
+
+/// Where the real camera's rotation comes from.
+enum class RotationSource {
+  kImu,     ///< the gyro samples given to AddGyro
+  kVisual,  ///< the video itself (visual/visual_rotation.h); AddGyro ignored
 };
 
 /// All options of one stream.
@@ -37,6 +44,9 @@ struct PipelineOptions {
     o.max_extrapolation_s = 0.05;
     return o;
   }();
+  /// kVisual: a camera without an IMU. The gyro check is off then.
+  RotationSource rotation_source = RotationSource::kImu;
+  VisualRotationOptions visual;
   LandmarkSource landmark_source = LandmarkSource::kDlib;
   FaceTrackerOptions face;
   StabilizerOptions stabilizer;
@@ -99,6 +109,8 @@ struct PipelineFrame {
   PipelineTimings timings;
   /// The gyro-vs-video check over its window (GyroVideoCheck).
   GyroVideoCheckResult gyro_video_check;
+  /// rotation_source kVisual: this frame's rotation from the video.
+  VisualRotation visual;
   /// The clock offset correction the timeline applied to this frame, on top
   /// of imu/time_offset (gyro_video_check/apply_offset; else 0) [s].
   double imu_offset_applied_s = 0.0;
@@ -199,6 +211,9 @@ class Pipeline {
   // WarpStep in composite mode: both layers' pictures and their composite.
   Status CompositeStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
                        PipelineFrame* f);
+  // rotation_source kVisual: the rotation from this frame and the previous
+  // one, fed into the timeline as a camera-frame angular velocity.
+  Status VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f);
   Pipeline(const CameraModel& model, const PipelineOptions& options);
   void ApplyOffsetEstimate(Time stamp);
 
@@ -210,6 +225,9 @@ class Pipeline {
   std::unique_ptr<Stabilizer> stabilizer_;
   std::unique_ptr<Warper> warper_;
   std::unique_ptr<GyroVideoCheck> check_;  // null when disabled
+  std::unique_ptr<VisualRotationEstimator> visual_;  // rotation_source kVisual
+  cv::Rect2d last_face_box_;                         // kVisual: left out of the features
+  Time visual_mid_;                                  // kVisual: the last frame's middle row
   std::unique_ptr<SubjectRegionTracker> region_;  // layered and composite mode
   std::unique_ptr<Compositor> compositor_;       // composite mode
   cv::Mat subject_picture_;                      // composite: the subject layer's

@@ -1,0 +1,119 @@
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/camera/camera_model.h"
+#include "steadiface_core/camera/rolling_shutter.h"
+#include "steadiface_core/common/status.h"
+#include "steadiface_core/common/time.h"
+
+namespace steadiface {
+
+struct VisualRotationOptions {
+  /// Features are tracked on a grey copy at most this long [px].
+  int max_side_px = 640;
+  /// Features tracked at most [count]; refilled when fewer than half remain.
+  int max_features = 200;
+  /// Smallest distance between two features, in the copy [px].
+  double min_distance_px = 15.0;
+  /// KLT window side [px, odd] and pyramid levels above the copy [count].
+  int klt_window_px = 21;
+  int klt_levels = 3;
+  /// A feature is tracked only where the picture has this much texture:
+  /// the smaller eigenvalue of the window's gradient matrix per pixel
+  /// (OpenCV's minEigThreshold; its default is 1e-4) [-]. Sensor noise on a
+  /// plain wall stays below it.
+  double min_texture = 1e-3;
+  /// A feature fits the rotation when it lands within this of its track,
+  /// in full-resolution pixels [px].
+  double inlier_threshold_px = 2.0;
+  /// RANSAC hypotheses (three features each) per frame, at most [count].
+  int ransac_iterations = 64;
+  /// A tracked feature's position error [px] and the typical rate of change
+  /// of a hand's angular velocity [rad/s^2] (0.5 rad/s at 6 Hz): together
+  /// the prior that keeps the within-frame change from fitting the noise.
+  double feature_noise_px = 1.0;
+  double alpha_prior_rad_s2 = 20.0;
+  /// A rotation is trusted with at least this many inliers [count] ...
+  int min_inliers = 20;
+  /// ... making up at least this fraction of the tracked features [-].
+  double min_inlier_ratio = 0.5;
+  /// The subject is left out: the face box grown by this fraction of its
+  /// width on each side and above [-], and below it a column this many
+  /// face widths wide down to the image's bottom (the body) [-].
+  double face_margin = 0.5;
+  double body_width = 3.0;
+};
+
+Status ValidateVisualRotationOptions(const VisualRotationOptions& options);
+
+/// One frame's estimate: the camera's angular velocity between the
+/// previous frame and this one.
+struct VisualRotation {
+  /// Trusted: enough inliers, a large enough share of the tracks.
+  bool valid = false;
+  /// Camera-frame angular velocity at `stamp` [rad/s] (0 when invalid: the
+  /// camera is held still rather than moved by a wrong motion).
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero();
+  /// Its time: half-way between the two frames' middle rows.
+  Time stamp;
+  /// The angular velocity's rate of change across the pair [rad/s^2]:
+  /// omega(t) = omega + alpha (t - stamp) from the previous frame's first
+  /// row to this one's last (0 when invalid).
+  Eigen::Vector3d alpha = Eigen::Vector3d::Zero();
+  int tracked = 0;  ///< feature pairs outside the subject [count]
+  int inliers = 0;  ///< pairs that fit the rotation [count]
+  /// RMS reprojection error of the inliers [px].
+  double residual_px = 0.0;
+  double ms = 0.0;  ///< wall time of Process [ms]
+};
+
+/// The camera's rotation from the video alone, for a camera without an IMU
+/// (or while it drops out): background features tracked from the previous
+/// frame (KLT), the subject left out, and a rotation-only motion fitted
+/// robustly (RANSAC on pairs of features, then Gauss-Newton on the
+/// inliers), so that people and objects moving through the view are
+/// outliers. The angular velocity varies linearly in time across the pair
+/// (a hand's shake changes it within a frame), and each feature moves by
+/// its integral between the times of the rows it was seen on (rolling
+/// shutter), so each row later gets its own rotation as with a gyro.
+/// Causal: frame n's estimate uses frames n-1 and n only. Not thread-safe.
+class VisualRotationEstimator {
+ public:
+  static Status Create(const CameraModel& model, const RowTiming& timing,
+                       const VisualRotationOptions& options,
+                       std::unique_ptr<VisualRotationEstimator>* out);
+
+  /// One frame: `gray` is 8-bit single-channel at the model's size; `face`
+  /// (empty if none) the subject's face box in this frame [px]. The first
+  /// frame, and one after Reset(), gives an invalid estimate.
+  Status Process(const cv::Mat& gray, Time stamp, const cv::Rect2d& face,
+                 VisualRotation* out);
+  void Reset();
+
+ private:
+  VisualRotationEstimator(const CameraModel& model, const RowTiming& timing,
+                          const VisualRotationOptions& options);
+  // Features to track from the copy `small` (outside `mask`), topped up to
+  // max_features.
+  void Refill(const cv::Mat& small, const cv::Mat& mask);
+  // The previous frame's features tracked into `small`, the rotation
+  // fitted, the features that fit kept.
+  void Track(const cv::Mat& small, const cv::Mat& mask, Time stamp,
+             VisualRotation* out);
+  cv::Mat SubjectMask(const cv::Size& size, const cv::Rect2d& face) const;
+
+  const CameraModel model_;
+  const RowTiming timing_;
+  const VisualRotationOptions options_;
+  double scale_ = 1.0;  // copy / full resolution
+  cv::Mat prev_;        // the previous copy
+  Time prev_stamp_;
+  std::vector<cv::Point2f> prev_points_;  // in the copy
+};
+
+}  // namespace steadiface

@@ -1,0 +1,127 @@
+#include "visual/rotation_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <Eigen/Dense>
+
+#include "steadiface_core/common/so3.h"
+
+namespace steadiface {
+namespace visual {
+namespace {
+
+double ErrorPx(const Motion& omega, const BearingPair& p, double focal_px) {
+  return (Predict(omega, p) - p.n2).norm() * focal_px;
+}
+
+std::vector<int> Inliers(const std::vector<BearingPair>& pairs,
+                         const Motion& omega, double focal_px,
+                         double threshold_px) {
+  std::vector<int> in;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (ErrorPx(omega, pairs[i], focal_px) < threshold_px)
+      in.push_back(static_cast<int>(i));
+  }
+  return in;
+}
+
+// Gauss-Newton on the pairs `in` (6 unknowns), damped a little so that a
+// triple's nearly singular system stays bounded. The Jacobian takes the
+// rotation as small (b2 + b2 x dphi for a change dphi): one frame's turn
+// is a few degrees, and the residuals themselves are exact.
+Motion Refine(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
+              Motion m, int iterations, double alpha_weight) {
+  for (int iter = 0; iter < iterations; ++iter) {
+    Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> Jtr = Eigen::Matrix<double, 6, 1>::Zero();
+    for (int i : in) {
+      const BearingPair& p = pairs[i];
+      const Eigen::Vector3d b2 =
+          ExpSO3(-(p.c * m.head<3>() + p.d * m.tail<3>())) * p.b1;
+      const Eigen::Vector2d r = b2.head<2>() / b2.z() - p.n2;
+      Eigen::Matrix<double, 2, 3> Jp;  // d(x/z, y/z) / d b2
+      Jp << 1.0 / b2.z(), 0.0, -b2.x() / (b2.z() * b2.z()), 0.0, 1.0 / b2.z(),
+          -b2.y() / (b2.z() * b2.z());
+      Eigen::Matrix3d skew;  // d b2 / d phi, with b2 = Exp(-phi) b1
+      skew << 0.0, -b2.z(), b2.y(), b2.z(), 0.0, -b2.x(), -b2.y(), b2.x(), 0.0;
+      const Eigen::Matrix<double, 2, 3> Jphi = Jp * skew;
+      Eigen::Matrix<double, 2, 6> J;
+      J << p.c * Jphi, p.d * Jphi;
+      JtJ += J.transpose() * J;
+      Jtr += J.transpose() * r;
+    }
+    // The prior on alpha: alpha_weight |alpha|^2.
+    JtJ.diagonal().tail<3>().array() += alpha_weight;
+    Jtr.tail<3>() += alpha_weight * m.tail<3>();
+    JtJ.diagonal() *= 1.0 + 1e-9;
+    JtJ.diagonal().array() += 1e-12;
+    const Motion delta = JtJ.ldlt().solve(-Jtr);
+    if (!delta.allFinite()) break;
+    m += delta;
+    if (delta.norm() < 1e-7) break;
+  }
+  return m;
+}
+
+}  // namespace
+
+Eigen::Vector2d Predict(const Motion& m, const BearingPair& p) {
+  const Eigen::Vector3d phi = p.c * m.head<3>() + p.d * m.tail<3>();
+  const Eigen::Vector3d b2 = ExpSO3(-phi) * p.b1;
+  return b2.head<2>() / b2.z();
+}
+
+bool FitMotion(const std::vector<BearingPair>& pairs, double focal_px,
+               double threshold_px, int iterations, double alpha_weight,
+               uint64_t seed, RotationFit* fit) {
+  const int n = static_cast<int>(pairs.size());
+  if (n < 3) return false;
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  std::vector<int> best;
+  Motion best_m = Motion::Zero();
+  // Adaptive: stop once a hypothesis with this share of inliers would have
+  // been drawn with 99 % probability, after at least kMinIterations.
+  constexpr int kMinIterations = 24;
+  int needed = iterations;
+  for (int it = 0; it < needed; ++it) {
+    const int a = pick(rng);
+    const int b = (a + 1 + pick(rng) % (n - 1)) % n;
+    int c = pick(rng);
+    if (c == a || c == b) continue;
+    const Motion m = Refine(pairs, {a, b, c}, Motion::Zero(), 3, alpha_weight);
+    if (!m.allFinite()) continue;
+    std::vector<int> in = Inliers(pairs, m, focal_px, threshold_px);
+    if (in.size() > best.size()) {
+      best.swap(in);
+      best_m = m;
+      const double w = static_cast<double>(best.size()) / n;
+      const double miss = 1.0 - w * w * w;
+      if (miss < 1e-9) {
+        needed = std::min(needed, std::max(it + 1, kMinIterations));
+      } else {
+        needed = std::min(
+            needed,
+            std::max(kMinIterations, static_cast<int>(std::ceil(
+                                         std::log(0.01) / std::log(miss)))));
+      }
+    }
+  }
+  if (best.size() < 3) return false;
+  for (int round = 0; round < 2; ++round) {
+    best_m = Refine(pairs, best, best_m, 5, alpha_weight);
+    best = Inliers(pairs, best_m, focal_px, threshold_px);
+    if (best.size() < 3) return false;
+  }
+  double ss = 0.0;
+  for (int i : best) ss += std::pow(ErrorPx(best_m, pairs[i], focal_px), 2);
+  fit->motion = best_m;
+  fit->inliers = best;
+  fit->rms_px = std::sqrt(ss / best.size());
+  return true;
+}
+
+}  // namespace visual
+}  // namespace steadiface

@@ -1,0 +1,242 @@
+#include "steadiface_core/visual/visual_rotation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "steadiface_core/camera/lens_distortion.h"
+#include "visual/rotation_fit.h"
+
+namespace steadiface {
+
+Status ValidateVisualRotationOptions(const VisualRotationOptions& o) {
+  std::ostringstream err;
+  if (o.max_side_px < 64 || o.max_side_px > 8192) {
+    err << "visual.max_side_px must be in [64, 8192], got " << o.max_side_px;
+  } else if (o.max_features < 8 || o.max_features > 5000) {
+    err << "visual.max_features must be in [8, 5000], got " << o.max_features;
+  } else if (!(o.min_distance_px >= 1.0 && o.min_distance_px <= 200.0)) {
+    err << "visual.min_distance_px must be in [1, 200], got "
+        << o.min_distance_px;
+  } else if (o.klt_window_px < 5 || o.klt_window_px > 101 ||
+             o.klt_window_px % 2 == 0) {
+    err << "visual.klt_window_px must be odd, in [5, 101], got "
+        << o.klt_window_px;
+  } else if (!(o.min_texture > 0.0 && o.min_texture <= 1.0)) {
+    err << "visual.min_texture must be in (0, 1], got " << o.min_texture;
+  } else if (o.klt_levels < 0 || o.klt_levels > 8) {
+    err << "visual.klt_levels must be in [0, 8], got " << o.klt_levels;
+  } else if (!(o.inlier_threshold_px > 0.0 && o.inlier_threshold_px <= 50.0)) {
+    err << "visual.inlier_threshold_px must be in (0, 50], got "
+        << o.inlier_threshold_px;
+  } else if (o.ransac_iterations < 1 || o.ransac_iterations > 10000) {
+    err << "visual.ransac_iterations must be in [1, 10000], got "
+        << o.ransac_iterations;
+  } else if (o.min_inliers < 2 || o.min_inliers > o.max_features) {
+    err << "visual.min_inliers must be in [2, max_features], got "
+        << o.min_inliers;
+  } else if (!(o.min_inlier_ratio >= 0.0 && o.min_inlier_ratio <= 1.0)) {
+    err << "visual.min_inlier_ratio must be in [0, 1], got "
+        << o.min_inlier_ratio;
+  } else if (!(o.feature_noise_px > 0.0 && o.feature_noise_px <= 20.0) ||
+             !(o.alpha_prior_rad_s2 > 0.0 && o.alpha_prior_rad_s2 <= 1e4)) {
+    err << "visual.feature_noise_px must be in (0, 20] and alpha_prior_rad_s2 "
+           "in (0, 1e4]";
+  } else if (!(o.face_margin >= 0.0 && o.face_margin <= 10.0) ||
+             !(o.body_width >= 0.0 && o.body_width <= 20.0)) {
+    err << "visual.face_margin must be in [0, 10] and body_width in [0, 20]";
+  }
+  if (err.tellp() != 0) return Status::Error(err.str());
+  return Status::Ok();
+}
+
+Status VisualRotationEstimator::Create(
+    const CameraModel& model, const RowTiming& timing,
+    const VisualRotationOptions& options,
+    std::unique_ptr<VisualRotationEstimator>* out) {
+  Status s = ValidateVisualRotationOptions(options);
+  if (!s.ok()) return s;
+  if (timing.height() != model.intrinsics().height) {
+    return Status::Error(
+        "visual rotation: row timing is for another image height");
+  }
+  out->reset(new VisualRotationEstimator(model, timing, options));
+  return Status::Ok();
+}
+
+VisualRotationEstimator::VisualRotationEstimator(
+    const CameraModel& model, const RowTiming& timing,
+    const VisualRotationOptions& options)
+    : model_(model), timing_(timing), options_(options) {
+  const CameraIntrinsics& k = model.intrinsics();
+  const int longest = std::max(k.width, k.height);
+  scale_ = longest > options.max_side_px
+               ? static_cast<double>(options.max_side_px) / longest
+               : 1.0;
+}
+
+void VisualRotationEstimator::Reset() {
+  prev_.release();
+  prev_points_.clear();
+}
+
+cv::Mat VisualRotationEstimator::SubjectMask(const cv::Size& size,
+                                             const cv::Rect2d& face) const {
+  // 255 where features may be taken (the copy's pixels).
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
+  if (face.width <= 0.0 || face.height <= 0.0) return mask;
+  const double m = options_.face_margin * face.width;
+  const cv::Rect2d head(face.x - m, face.y - m, face.width + 2 * m,
+                        face.height + m);
+  const double bw = options_.body_width * face.width;
+  const double cx = face.x + 0.5 * face.width;
+  const cv::Rect2d body(cx - 0.5 * bw, face.br().y, bw, 1e6);
+  for (const cv::Rect2d& r : {head, body}) {
+    const cv::Rect s(
+        cv::Point(static_cast<int>(std::floor(r.x * scale_)),
+                  static_cast<int>(std::floor(r.y * scale_))),
+        cv::Point(
+            static_cast<int>(std::ceil(r.br().x * scale_)),
+            static_cast<int>(std::ceil(std::min(r.br().y, 1e5) * scale_))));
+    const cv::Rect clipped = s & cv::Rect(0, 0, size.width, size.height);
+    if (clipped.area() > 0) mask(clipped).setTo(0);
+  }
+  return mask;
+}
+
+void VisualRotationEstimator::Refill(const cv::Mat& small,
+                                     const cv::Mat& mask) {
+  if (static_cast<int>(prev_points_.size()) >= options_.max_features / 2)
+    return;
+  cv::Mat free = mask.clone();
+  const int r = static_cast<int>(std::ceil(options_.min_distance_px));
+  for (const cv::Point2f& p : prev_points_)
+    cv::circle(free, p, r, cv::Scalar(0), -1);
+  std::vector<cv::Point2f> fresh;
+  const int want =
+      options_.max_features - static_cast<int>(prev_points_.size());
+  cv::goodFeaturesToTrack(small, fresh, want, 0.01, options_.min_distance_px,
+                          free, 5);
+  prev_points_.insert(prev_points_.end(), fresh.begin(), fresh.end());
+}
+
+namespace {
+
+// A copy pixel to the camera ray (X/Z, Y/Z) through it.
+Eigen::Vector2d Ray(const CameraModel& model, double scale,
+                    const cv::Point2f& p) {
+  Eigen::Vector2d px((p.x + 0.5) / scale - 0.5, (p.y + 0.5) / scale - 0.5);
+  const CameraIntrinsics& k = model.intrinsics();
+  if (k.HasDistortion()) UndistortPixel(k, px, &px);
+  return (model.PixelToNormalized(px) - Eigen::Vector2d(0.5, 0.5)) /
+         model.real_focal();
+}
+
+}  // namespace
+
+void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
+                                    Time stamp, VisualRotation* out) {
+  std::vector<cv::Point2f> next;
+  std::vector<unsigned char> status;
+  std::vector<float> error;
+  const int w = options_.klt_window_px;
+  cv::calcOpticalFlowPyrLK(
+      prev_, small, prev_points_, next, status, error, cv::Size(w, w),
+      options_.klt_levels,
+      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30,
+                       0.01),
+      0, options_.min_texture);
+  std::vector<visual::BearingPair> pairs;
+  std::vector<cv::Point2f> kept;
+  const cv::Rect2f inside(0.f, 0.f, small.cols - 1.f, small.rows - 1.f);
+  for (size_t i = 0; i < next.size(); ++i) {
+    if (!status[i] || !inside.contains(next[i]) ||
+        mask.at<unsigned char>(cvRound(next[i].y), cvRound(next[i].x)) == 0) {
+      continue;
+    }
+    visual::BearingPair p;
+    const Eigen::Vector2d r1 = Ray(model_, scale_, prev_points_[i]);
+    p.b1 = Eigen::Vector3d(r1.x(), r1.y(), 1.0);
+    p.n2 = Ray(model_, scale_, next[i]);
+    const double y1 = (prev_points_[i].y + 0.5) / scale_ - 0.5;
+    const double y2 = (next[i].y + 0.5) / scale_ - 0.5;
+    const double t1 = ToSeconds(timing_.RowTime(prev_stamp_, y1) - out->stamp);
+    const double t2 = ToSeconds(timing_.RowTime(stamp, y2) - out->stamp);
+    p.c = t2 - t1;
+    p.d = 0.5 * (t2 * t2 - t1 * t1);
+    pairs.push_back(p);
+    kept.push_back(next[i]);
+  }
+  out->tracked = static_cast<int>(pairs.size());
+  visual::RotationFit fit;
+  const double focal_px = model_.real_focal() * model_.intrinsics().width;
+  const double sigma_n = options_.feature_noise_px / focal_px;
+  const double alpha_weight =
+      sigma_n * sigma_n /
+      (options_.alpha_prior_rad_s2 * options_.alpha_prior_rad_s2);
+  if (visual::FitMotion(pairs, focal_px, options_.inlier_threshold_px,
+                        options_.ransac_iterations, alpha_weight,
+                        static_cast<uint64_t>(ToNanoseconds(stamp)), &fit)) {
+    out->inliers = static_cast<int>(fit.inliers.size());
+    out->residual_px = fit.rms_px;
+    out->valid = out->inliers >= options_.min_inliers &&
+                 out->inliers >= options_.min_inlier_ratio * out->tracked;
+    if (out->valid) {
+      out->omega = fit.motion.head<3>();
+      out->alpha = fit.motion.tail<3>();
+    }
+    // Keep tracking the features that moved with the camera: a passer-by's
+    // are dropped, and fresh ones are found where the scene is.
+    std::vector<cv::Point2f> in;
+    in.reserve(fit.inliers.size());
+    for (int i : fit.inliers) in.push_back(kept[i]);
+    kept.swap(in);
+  }
+  prev_points_.swap(kept);
+}
+
+Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
+                                        const cv::Rect2d& face,
+                                        VisualRotation* out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  *out = VisualRotation();
+  out->stamp = stamp;
+  const CameraIntrinsics& k = model_.intrinsics();
+  if (gray.empty() || gray.type() != CV_8UC1 || gray.cols != k.width ||
+      gray.rows != k.height) {
+    return Status::Error("visual rotation: need an 8-bit grey " +
+                         std::to_string(k.width) + "x" +
+                         std::to_string(k.height) + " image");
+  }
+  if (!prev_.empty() && stamp <= prev_stamp_)
+    Reset();  // time went back: start over
+  cv::Mat small;
+  if (scale_ < 1.0) {
+    cv::resize(gray, small, cv::Size(), scale_, scale_, cv::INTER_AREA);
+  } else {
+    small = gray.clone();
+  }
+  const cv::Mat mask = SubjectMask(small.size(), face);
+  if (!prev_.empty() && !prev_points_.empty()) {
+    const double mid = 0.5 * (k.height - 1);
+    out->stamp =
+        timing_.RowTime(prev_stamp_, mid) +
+        (timing_.RowTime(stamp, mid) - timing_.RowTime(prev_stamp_, mid)) / 2;
+    Track(small, mask, stamp, out);
+  } else {
+    prev_points_.clear();
+  }
+  Refill(small, mask);
+  prev_ = small;
+  prev_stamp_ = stamp;
+  out->ms = std::chrono::duration<double, std::milli>(
+                std::chrono::steady_clock::now() - t0)
+                .count();
+  return Status::Ok();
+}
+
+}  // namespace steadiface
