@@ -214,6 +214,7 @@ namespace {
 void ReadRosLayer(Reader& r, steadiface::PipelineOptions* po, WrapperOptions* wo) {
   using steadiface::LandmarkSource;
   using steadiface::LateFramePolicy;
+  using steadiface::RotationSource;
   r.Str("camera_frame", &wo->camera_frame);
   r.Choice("image_transport", &wo->image_transport);
   r.Str("camera_info_url", &wo->camera_info_url);
@@ -238,6 +239,9 @@ void ReadRosLayer(Reader& r, steadiface::PipelineOptions* po, WrapperOptions* wo
                        : po->landmark_source == LandmarkSource::kNone   ? "none"
                                                                         : "dlib";
   r.Choice("landmark_source", &source);
+  std::string rotation = po->rotation_source == RotationSource::kVisual ? "visual" : "imu";
+  r.Choice("rotation_source", &rotation);
+  po->rotation_source = rotation == "visual" ? RotationSource::kVisual : RotationSource::kImu;
   po->landmark_source = source == "topic"  ? LandmarkSource::kExternal
                         : source == "none" ? LandmarkSource::kNone
                                            : LandmarkSource::kDlib;

@@ -111,6 +111,7 @@ void StabilizerRos::StartDiagnostics() {
   updater_->add(*image_freq_);
   updater_->add(*imu_freq_);
   updater_->add("gyro", this, &StabilizerRos::DiagGyro);
+  updater_->add("rotation source", this, &StabilizerRos::DiagRotationSource);
   updater_->add("face", this, &StabilizerRos::DiagFace);
   updater_->add("solver", this, &StabilizerRos::DiagSolver);
   updater_->add("frames", this, &StabilizerRos::DiagFrames);
@@ -301,7 +302,10 @@ void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
               steadiface::SampleResultName(static_cast<steadiface::SampleResult>(i)),
           w.timeline.samples[i]);
   }
-  if (!imu_seen_ && since > wrapper_options_.scheduler.imu_timeout_s) {
+  if (w.visual_rotation) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK,
+              "not used: rotation_source is visual (see \"rotation source\")");
+  } else if (!imu_seen_ && since > wrapper_options_.scheduler.imu_timeout_s) {
     s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no IMU data: frames are not stabilized");
   } else if (since > wrapper_options_.scheduler.imu_timeout_s) {
     s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "IMU stopped");
@@ -310,6 +314,29 @@ void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
               "IMU rejects, gaps or extrapolated frames (see values)");
   } else {
     s.summary(diagnostic_msgs::DiagnosticStatus::OK, "gyro covers every frame");
+  }
+}
+
+void StabilizerRos::DiagRotationSource(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const WrapperStatus w = wrapper_->Status();
+  if (!w.visual_rotation) {
+    s.add("source", "imu");
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "imu");
+    return;
+  }
+  s.add("source", "visual");
+  s.add("tracked features", w.visual.tracked);
+  s.add("inliers", w.visual.inliers);
+  s.add("residual [px]", w.visual.residual_px);
+  s.add("time [ms]", w.visual.ms);
+  if (!w.pipeline_ready) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "visual: waiting for the first image");
+  } else if (w.visual.valid) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "visual");
+  } else {
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+              "visual: too few features fit one rotation (texture, darkness, a crowd); "
+              "holding the camera still");
   }
 }
 

@@ -292,7 +292,10 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   cv::Mat image;
   if (!ToCheckedImage(p, &image)) return;
   const steadiface::Time stamp = ToCoreTime(p.image->header.stamp);
-  const steadiface::FrameDisposition d = scheduler_.Dispose(stamp, late);
+  // The visual rotation source needs no IMU: every frame is processed.
+  const bool visual = options_.rotation_source == steadiface::RotationSource::kVisual;
+  const steadiface::FrameDisposition d =
+      visual ? steadiface::FrameDisposition::kProcess : scheduler_.Dispose(stamp, late);
   if (d == steadiface::FrameDisposition::kNoImu) {
     PublishPassthrough(p, image, started);
     return;
@@ -544,6 +547,7 @@ void StabilizerWrapper::PublishDebugImage(const steadiface::PipelineFrame& frame
 void StabilizerWrapper::UpdateStatus(const steadiface::PipelineFrame& frame,
                                      const std_msgs::Header& in_header) {
   status_.gyro_video_check = frame.gyro_video_check;
+  status_.visual = frame.visual;
   status_.imu_offset_applied_s = frame.imu_offset_applied_s;
   status_.face_state = frame.face.state;
   status_.face_failure = steadiface::FaceFailureName(frame.face.failure);
@@ -563,6 +567,7 @@ WrapperStatus StabilizerWrapper::Status() const {
   s.counters = counters_;
   s.pipeline_ready = pipeline_ != nullptr;
   s.imu_ever = scheduler_.have_gyro();
+  s.visual_rotation = options_.rotation_source == steadiface::RotationSource::kVisual;
   if (pipeline_) {
     s.timeline = pipeline_->timeline().stats();
     s.stabilizer = pipeline_->stabilizer().stats();

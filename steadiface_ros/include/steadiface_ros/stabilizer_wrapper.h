@@ -118,6 +118,10 @@ struct WrapperStatus {
   std::string landmark_model_error;
   /// The gyro-vs-video check as of the last frame.
   steadiface::GyroVideoCheckResult gyro_video_check;
+  /// rotation_source visual: whether it is on, and the last frame's
+  /// rotation from the video.
+  bool visual_rotation = false;
+  steadiface::VisualRotation visual;
   /// The clock offset correction applied on top of imu/time_offset [s].
   double imu_offset_applied_s = 0.0;
   /// The IMU extrinsics' source, and the frames of their TF lookup.
