@@ -6,7 +6,9 @@
 // full-frame detection) is outside the timed loop. Counters: median stage
 // times over the timed frames. The fourth argument picks the warp mode
 // (0 global, 1 layered: both layers' meshes and the band's optimization;
-// 2 composite: both layers' pictures, the matte, the plate and the blend).
+// 2 composite: both layers' pictures, the matte, the plate and the blend);
+// the fifth the rotation source (0 the IMU, 1 the video: visual_ms is the
+// visual source's median).
 #include <algorithm>
 #include <vector>
 
@@ -62,9 +64,10 @@ void BM_PipelineFrame(benchmark::State& state) {
   po.warp.num_threads = static_cast<int>(state.range(2));
   if (state.range(3) == 1) po.warp.mode = WarpMode::kLayered;
   if (state.range(3) == 2) po.warp.mode = WarpMode::kComposite;
+  if (state.range(4) == 1) po.rotation_source = RotationSource::kVisual;
   std::unique_ptr<Pipeline> p;
   size_t g = 0, i = 0;
-  std::vector<double> face, stab, warp, mesh, composite, matte, plate, blend, total;
+  std::vector<double> face, stab, warp, mesh, composite, matte, plate, blend, total, visual;
   double check_sum = 0.0, check_max = 0.0;
   // A fresh pipeline that has acquired the face on the first frame.
   auto restart = [&]() -> bool {
@@ -104,6 +107,7 @@ void BM_PipelineFrame(benchmark::State& state) {
     plate.push_back(out.composite.report.plate_ms);
     blend.push_back(out.composite.report.blend_ms);
     total.push_back(out.timings.total_ms);
+    visual.push_back(out.visual.ms);
     check_sum += out.timings.check_ms;
     check_max = std::max(check_max, out.timings.check_ms);
   }
@@ -115,6 +119,7 @@ void BM_PipelineFrame(benchmark::State& state) {
   state.counters["matte_ms"] = Percentile(matte, 0.5);
   state.counters["plate_ms"] = Percentile(plate, 0.5);
   state.counters["blend_ms"] = Percentile(blend, 0.5);
+  state.counters["visual_ms"] = Percentile(visual, 0.5);
   // The gyro-vs-video check runs on one frame pair in `stride`: its mean
   // per frame, and the checked frames' cost.
   state.counters["check_mean_ms"] = total.empty() ? 0.0 : check_sum / total.size();
@@ -126,19 +131,22 @@ void BM_PipelineFrame(benchmark::State& state) {
 }
 
 BENCHMARK(BM_PipelineFrame)
-    ->Args({640, 360, 1, 0})
-    ->Args({1280, 720, 1, 0})
-    ->Args({1920, 1080, 1, 0})
-    ->Args({640, 360, 2, 0})
-    ->Args({1280, 720, 2, 0})
-    ->Args({1920, 1080, 2, 0})
-    ->Args({640, 360, 1, 1})
-    ->Args({1280, 720, 1, 1})
-    ->Args({1920, 1080, 1, 1})
-    ->Args({640, 360, 1, 2})
-    ->Args({1280, 720, 1, 2})
-    ->Args({1920, 1080, 1, 2})
-    ->ArgNames({"w", "h", "threads", "mode"})
+    ->Args({640, 360, 1, 0, 0})
+    ->Args({1280, 720, 1, 0, 0})
+    ->Args({1920, 1080, 1, 0, 0})
+    ->Args({640, 360, 2, 0, 0})
+    ->Args({1280, 720, 2, 0, 0})
+    ->Args({1920, 1080, 2, 0, 0})
+    ->Args({640, 360, 1, 1, 0})
+    ->Args({1280, 720, 1, 1, 0})
+    ->Args({1920, 1080, 1, 1, 0})
+    ->Args({640, 360, 1, 2, 0})
+    ->Args({1280, 720, 1, 2, 0})
+    ->Args({1920, 1080, 1, 2, 0})
+    ->Args({640, 360, 1, 0, 1})
+    ->Args({1280, 720, 1, 0, 1})
+    ->Args({1920, 1080, 1, 0, 1})
+    ->ArgNames({"w", "h", "threads", "mode", "rotation"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

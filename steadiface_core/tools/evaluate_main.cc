@@ -165,6 +165,8 @@ int Usage() {
                "         at most once per S while no face is locked; 0 = every frame)\n"
                "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
                "         shows a 30 px face)\n"
+               "       [--rotation-source imu|visual] (visual: the camera's rotation from\n"
+               "         the video, the IMU unused)\n"
                "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
                "         widths of where the background layer shows the face)\n"
                "       [--reach-lowpass HZ] [--reach-hold F] (stabilizer.subject_reach_lowpass,\n"
@@ -270,6 +272,7 @@ int main(int argc, char** argv) {
   double gyro_scale = NAN, gyro_speed = NAN;
   double search_interval = NAN;  // face.search_interval [s]; NaN: the default
   double head_distance = NAN;    // the subject's distance [m]; NaN: the preset's
+  bool visual_rotation = false;  // --rotation-source visual
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
   double subject_reach = 0.0;    // stabilizer.subject_reach [jaw widths]; 0: off
@@ -291,6 +294,10 @@ int main(int argc, char** argv) {
   cl.Double("--readout-error", &readout_error).Double("--gyro-scale", &gyro_scale);
   cl.Double("--gyro-speed", &gyro_speed).Double("--search-interval", &search_interval);
   cl.Double("--head-distance", &head_distance);
+  cl.Value("--rotation-source", "imu or visual", [&](const std::string& v) {
+    visual_rotation = v == "visual";
+    return v == "imu" || v == "visual";
+  });
   cl.Double("--head-w-stay", &head_w_stay).Double("--head-d-ref", &head_d_ref);
   cl.Double("--subject-reach", &subject_reach).Double("--reach-lowpass", &reach_lowpass);
   cl.Double("--reach-hold", &reach_hold).Flag("--feasible-set", &feasible_set);
@@ -474,6 +481,7 @@ int main(int argc, char** argv) {
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
         if (std::isfinite(search_interval)) po.face.search_interval_s = search_interval;
+        if (visual_rotation) po.rotation_source = steadiface::RotationSource::kVisual;
         if (std::isfinite(head_w_stay)) po.stabilizer.head.w_stay = head_w_stay;
         if (std::isfinite(head_d_ref)) po.stabilizer.head.d_ref = head_d_ref;
         po.stabilizer.subject_reach = subject_reach;
