@@ -5,7 +5,8 @@ strictly increasing TF, lower head jitter than the input (ground truth from
 the simulator's CSV sidecar), a reconfigure of w_fit reaching the state
 topic, and the documented diagnostics, one test method each. With
 --no-imu: ERROR diagnostic within 2 s and unstabilized frames still
-published; --layered, --equivalence and --bag-loop run their own cases."""
+published; --visual: no IMU, rotation_source visual, stabilized frames
+within 1.5 s and the "rotation source" diagnostic saying visual; --layered, --equivalence and --bag-loop run their own cases."""
 import argparse
 import csv
 import math
@@ -25,7 +26,7 @@ from steadiface.msg import StabilizerState
 from truth_file import read_truth
 
 ARGS = None
-KEYS = ["gyro", "face", "solver", "frames", "protrusion", "image input rate", "imu input rate"]
+KEYS = ["gyro", "rotation source", "face", "solver", "frames", "protrusion", "image input rate", "imu input rate"]
 
 
 def quat_to_R(q):
@@ -139,6 +140,56 @@ class NoImuTest(unittest.TestCase):
         ok = wait_for(lambda: name in c.diag and c.diag[name][0] == DiagnosticStatus.ERROR, 2.5)
         self.assertTrue(ok, "no ERROR on '%s' within 2 s of the first frame: %s" % (name, c.diag.get(name)))
         self.assertLess(time.time() - t0, 2.6)
+
+
+class VisualRotationTest(unittest.TestCase):
+    """No IMU topic, rotation_source visual: the video gives the rotation."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.c = Collector(watch_input=True)
+        cls.first_input = None
+        cls.first_state = None
+        rospy.Subscriber("/camera/image_raw", Image, cls.on_input, queue_size=5)
+        rospy.Subscriber("/camera/state", StabilizerState, cls.on_first_state, queue_size=5)
+
+    @classmethod
+    def on_input(cls, m):
+        if cls.first_input is None:
+            cls.first_input = time.time()
+
+    @classmethod
+    def on_first_state(cls, m):
+        if cls.first_state is None:
+            cls.first_state = time.time()
+
+    def test_1_stabilized_within_1_5_s_of_the_first_image(self):
+        self.assertTrue(wait_for(lambda: self.first_input is not None, 40), "no input image")
+        self.assertTrue(wait_for(lambda: self.first_state is not None, 5.0),
+                        "no stabilized frame (state) without IMU")
+        self.assertLess(self.first_state - self.first_input, 1.5,
+                        "the first stabilized frame came more than 1.5 s after the first image")
+
+    def test_2_diagnostic_says_visual(self):
+        c = self.c
+        name = ARGS.node.lstrip("/") + ": rotation source"
+        ok = wait_for(lambda: name in c.diag and c.diag[name][1] == "visual", 10)
+        self.assertTrue(ok, "'%s' does not say visual: %s" % (name, c.diag.get(name)))
+        gyro = ARGS.node.lstrip("/") + ": gyro"
+        self.assertTrue(wait_for(lambda: gyro in c.diag, 5))
+        self.assertNotEqual(c.diag[gyro][0], DiagnosticStatus.ERROR, c.diag[gyro])
+
+    def test_3_frames_are_stabilized_and_the_camera_turns(self):
+        c = self.c
+        self.assertTrue(wait_for(lambda: len(c.states) >= 30, 40), "fewer than 30 frames stabilized")
+        with c.lock:
+            states = list(c.states)
+        for s in states:
+            q = s.real_rotation
+            self.assertTrue(all(math.isfinite(v) for v in (q.x, q.y, q.z, q.w)))
+        # The walk bag's camera shakes: the video must show it turning.
+        self.assertLess(min(abs(s.real_rotation.w) for s in states), 0.99999,
+                        "the video gave no rotation at all on a shaking camera")
 
 
 class StabilizerTest(unittest.TestCase):
@@ -408,6 +459,7 @@ if __name__ == "__main__":
     p.add_argument("--truth", default="")
     p.add_argument("--node", default="/camera/steadiface")
     p.add_argument("--no-imu", action="store_true")
+    p.add_argument("--visual", action="store_true")
     p.add_argument("--equivalence", action="store_true")
     p.add_argument("--bag-loop", action="store_true")
     p.add_argument("--layered", action="store_true")
@@ -418,5 +470,6 @@ if __name__ == "__main__":
     sys.argv = [sys.argv[0]] + rest
     rospy.init_node("stabilizer_rostest")
     case = (LayeredTest if ARGS.layered else EquivalenceTest if ARGS.equivalence else
-            BagLoopTest if ARGS.bag_loop else NoImuTest if ARGS.no_imu else StabilizerTest)
+            BagLoopTest if ARGS.bag_loop else NoImuTest if ARGS.no_imu else
+            VisualRotationTest if ARGS.visual else StabilizerTest)
     rostest.rosrun("steadiface", "stabilizer_rostest", case, sys.argv)
