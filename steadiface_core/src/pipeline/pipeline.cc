@@ -105,10 +105,11 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
     s = Compositor::Create(p->warper_->output_geometry(), options.composite, &p->compositor_);
     if (!s.ok()) return s;
   }
-  if (options.rotation_source == RotationSource::kVisual) {
+  if (options.rotation_source != RotationSource::kImu) {
     s = VisualRotationEstimator::Create(model, p->timing_, options.visual, &p->visual_);
     if (!s.ok()) return s;
-  } else if (options.gyro_video_check.enabled) {
+  }
+  if (options.rotation_source != RotationSource::kVisual && options.gyro_video_check.enabled) {
     s = GyroVideoCheck::Create(model.intrinsics(), p->timing_, options.imu.R_cam_imu.normalized(),
                                options.gyro_video_check, &p->check_);
     if (!s.ok()) return s;
@@ -118,12 +119,13 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
 }
 
 SampleResult Pipeline::AddGyro(const GyroSample& sample) {
-  if (visual_ != nullptr) return SampleResult::kAccepted;  // the video gives the rotation
+  // kVisual: the video gives the rotation.
+  if (options_.rotation_source == RotationSource::kVisual) return SampleResult::kAccepted;
   return timeline_.AddSample(sample);
 }
 
 bool Pipeline::GyroCovers(Time stamp) const {
-  if (visual_ != nullptr) return true;
+  if (options_.rotation_source == RotationSource::kVisual) return true;
   return timeline_.Covers(timing_.FirstRowTime(stamp)) &&
          timeline_.Covers(timing_.LastRowTime(stamp));
 }
@@ -142,8 +144,12 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   cv::Mat grey;
   if (visual_ != nullptr) {
     grey = ToGrey(image);
-    Status v = VisualStep(grey, stamp, &f);
+    f.rotation_from_video = options_.rotation_source == RotationSource::kVisual || imu_missing_;
+    Status v = f.rotation_from_video ? VisualStep(grey, stamp, &f)
+                                     : visual_->Remember(grey, stamp);
     if (!v.ok()) return v;
+    visual_mid_ = timing_.RowTime(stamp, 0.5 * (k.height - 1));
+    has_visual_mid_ = true;
   }
   // Face information.
   const auto t_face = std::chrono::steady_clock::now();
@@ -394,27 +400,32 @@ Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered
 Status Pipeline::VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f) {
   Status s = visual_->Process(grey, stamp, last_face_box_, &f->visual);
   if (!s.ok()) return s;
-  const double mid_row = 0.5 * (model_.intrinsics().height - 1);
-  const Time mid = timing_.RowTime(stamp, mid_row);
   const Time first_row = timing_.FirstRowTime(stamp);
   const Time last_row = timing_.LastRowTime(stamp);
-  // The first frame, or one that starts before the newest node (time ran
-  // back), starts the timeline afresh, the camera held still over it.
-  if (!timeline_.empty() && timeline_.newest() >= first_row) timeline_.reset();
-  if (timeline_.empty()) {
-    timeline_.AddOrientation(first_row - FromSeconds(1e-3), Eigen::Quaterniond::Identity(),
-                             Eigen::Vector3d::Zero());
-    timeline_.AddOrientation(last_row, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
-    visual_mid_ = mid;
+  // kVisual: the first frame, or one that starts before the newest node
+  // (time ran back), starts the timeline afresh, the camera held still over
+  // it. kAuto continues the gyro's timeline (the owner resets the stream
+  // when time runs back).
+  const bool visual_only = options_.rotation_source == RotationSource::kVisual;
+  if (visual_only && !timeline_.empty() && timeline_.newest() >= first_row) timeline_.reset();
+  if (timeline_.empty() || !has_visual_mid_) {
+    if (timeline_.empty()) {
+      timeline_.AddOrientation(first_row - FromSeconds(1e-3), Eigen::Quaterniond::Identity(),
+                               Eigen::Vector3d::Zero());
+    }
+    Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+    timeline_.CameraToWorld(timeline_.newest(), &q);
+    if (last_row > timeline_.newest()) timeline_.AddOrientation(last_row, q, Eigen::Vector3d::Zero());
     return Status::Ok();
   }
+  if (last_row <= timeline_.newest()) return Status::Ok();  // the gyro covers it after all
   // The rotation between the two frames' middle rows and across this
   // frame's rows is the pair's (omega + alpha (t - stamp)), from the
   // orientation at the previous frame's middle row: nodes every 2 ms from
-  // the newest (the previous frame's last row) to this frame's last row.
-  // The previous frame's rows keep the rotations they were given; the
-  // blanking between the frames takes up any difference. Not trusted: held
-  // still from the newest node.
+  // the newest (the previous frame's last row, or the gyro's newest sample)
+  // to this frame's last row. Rows already used keep the rotations they
+  // were given; the blanking between the frames takes up any difference.
+  // Not trusted: held still from the newest node.
   const bool held = !f->visual.valid;
   const Time anchor_t = held ? timeline_.newest() : visual_mid_;
   Eigen::Quaterniond anchor = Eigen::Quaterniond::Identity();
@@ -432,13 +443,13 @@ Status Pipeline::VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f) {
     const Eigen::Vector3d omega = f->visual.omega + f->visual.alpha * u;
     timeline_.AddOrientation(t, anchor * ExpSO3(phi), omega);
   }
-  visual_mid_ = mid;
   return Status::Ok();
 }
 
 void Pipeline::Reset() {
   timeline_.reset();
   if (visual_ != nullptr) visual_->Reset();
+  has_visual_mid_ = false;
   if (tracker_ != nullptr) tracker_->reset();
   stabilizer_->reset();
   if (check_ != nullptr) check_->Reset();

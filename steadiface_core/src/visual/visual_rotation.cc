@@ -214,13 +214,10 @@ Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
   }
   if (!prev_.empty() && stamp <= prev_stamp_)
     Reset();  // time went back: start over
-  cv::Mat small;
-  if (scale_ < 1.0) {
-    cv::resize(gray, small, cv::Size(), scale_, scale_, cv::INTER_AREA);
-  } else {
-    small = gray.clone();
-  }
+  const cv::Mat small = Copy(gray);
   const cv::Mat mask = SubjectMask(small.size(), face);
+  // After Remember() the previous frame has a picture but no features yet.
+  if (!prev_.empty() && prev_points_.empty()) Refill(prev_, mask);
   if (!prev_.empty() && !prev_points_.empty()) {
     const double mid = 0.5 * (k.height - 1);
     out->stamp =
@@ -236,6 +233,27 @@ Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
   out->ms = std::chrono::duration<double, std::milli>(
                 std::chrono::steady_clock::now() - t0)
                 .count();
+  return Status::Ok();
+}
+
+cv::Mat VisualRotationEstimator::Copy(const cv::Mat& gray) const {
+  cv::Mat small;
+  if (scale_ < 1.0) {
+    cv::resize(gray, small, cv::Size(), scale_, scale_, cv::INTER_AREA);
+  } else {
+    small = gray.clone();
+  }
+  return small;
+}
+
+Status VisualRotationEstimator::Remember(const cv::Mat& gray, Time stamp) {
+  const CameraIntrinsics& k = model_.intrinsics();
+  if (gray.empty() || gray.type() != CV_8UC1 || gray.cols != k.width || gray.rows != k.height) {
+    return Status::Error("visual rotation: need an 8-bit grey image of the camera's size");
+  }
+  prev_ = Copy(gray);
+  prev_stamp_ = stamp;
+  prev_points_.clear();
   return Status::Ok();
 }
 

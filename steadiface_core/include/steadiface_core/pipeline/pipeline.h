@@ -30,6 +30,10 @@ enum class LandmarkSource {
 enum class RotationSource {
   kImu,     ///< the gyro samples given to AddGyro
   kVisual,  ///< the video itself (visual/visual_rotation.h); AddGyro ignored
+  /// The gyro, and the video for the frames the owner marks as without IMU
+  /// data (SetImuMissing), continuing the same orientation timeline both
+  /// ways. With the IMU covering every frame the output is kImu's exactly.
+  kAuto,
 };
 
 /// All options of one stream.
@@ -44,8 +48,9 @@ struct PipelineOptions {
     o.max_extrapolation_s = 0.05;
     return o;
   }();
-  /// kVisual: a camera without an IMU. The gyro check is off then.
-  RotationSource rotation_source = RotationSource::kImu;
+  /// kVisual: a camera without an IMU (the gyro check is off then); kAuto:
+  /// the IMU while it flows, the video while it does not.
+  RotationSource rotation_source = RotationSource::kAuto;
   VisualRotationOptions visual;
   LandmarkSource landmark_source = LandmarkSource::kDlib;
   FaceTrackerOptions face;
@@ -109,7 +114,9 @@ struct PipelineFrame {
   PipelineTimings timings;
   /// The gyro-vs-video check over its window (GyroVideoCheck).
   GyroVideoCheckResult gyro_video_check;
-  /// rotation_source kVisual: this frame's rotation from the video.
+  /// The rotation of this frame came from the video (kVisual, or kAuto
+  /// without IMU data), and what the video gave.
+  bool rotation_from_video = false;
   VisualRotation visual;
   /// The clock offset correction the timeline applied to this frame, on top
   /// of imu/time_offset (gyro_video_check/apply_offset; else 0) [s].
@@ -138,6 +145,10 @@ class Pipeline {
 
   /// Buffers one gyro sample (rejections are counted in timeline stats).
   SampleResult AddGyro(const GyroSample& sample);
+  /// rotation_source kAuto: whether the next frames lack IMU data (the
+  /// gyro does not cover them), so that their rotation comes from the
+  /// video. Ignored in the other modes.
+  void SetImuMissing(bool missing) { imu_missing_ = missing; }
 
   /// True when the gyro covers the frame's last row (plus nothing else is
   /// needed to process it).
@@ -227,7 +238,9 @@ class Pipeline {
   std::unique_ptr<GyroVideoCheck> check_;  // null when disabled
   std::unique_ptr<VisualRotationEstimator> visual_;  // rotation_source kVisual
   cv::Rect2d last_face_box_;                         // kVisual: left out of the features
-  Time visual_mid_;                                  // kVisual: the last frame's middle row
+  Time visual_mid_;                                  // the last frame's middle row
+  bool has_visual_mid_ = false;
+  bool imu_missing_ = false;  // kAuto: SetImuMissing
   std::unique_ptr<SubjectRegionTracker> region_;  // layered and composite mode
   std::unique_ptr<Compositor> compositor_;       // composite mode
   cv::Mat subject_picture_;                      // composite: the subject layer's

@@ -94,6 +94,11 @@ class VisualRotationEstimator {
   Status Process(const cv::Mat& gray, Time stamp, const cv::Rect2d& face,
                  VisualRotation* out);
   void Reset();
+  /// Keeps `gray` (at `stamp`) as the previous frame without estimating
+  /// anything: the cheap step for frames whose rotation the gyro gives
+  /// (rotation_source auto), so that the first frame without IMU data has
+  /// a pair. Features are found on it only when they are needed.
+  Status Remember(const cv::Mat& gray, Time stamp);
 
  private:
   VisualRotationEstimator(const CameraModel& model, const RowTiming& timing,
@@ -106,6 +111,7 @@ class VisualRotationEstimator {
   void Track(const cv::Mat& small, const cv::Mat& mask, Time stamp,
              VisualRotation* out);
   cv::Mat SubjectMask(const cv::Size& size, const cv::Rect2d& face) const;
+  cv::Mat Copy(const cv::Mat& gray) const;  // the tracking copy of a frame
 
   const CameraModel model_;
   const RowTiming timing_;
