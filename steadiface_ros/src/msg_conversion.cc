@@ -474,6 +474,13 @@ void FillGyroVideoCheck(const steadiface::PipelineFrame& pf, steadiface::Stabili
   m.imu_offset_correction_s = c.offset_correction_s;
   m.imu_offset_off = c.offset_off;
   m.imu_offset_applied_s = pf.imu_offset_applied_s;
+  m.rotation_source = pf.rotation_from_video ? "visual" : "imu";
+  if (pf.rotation_from_video) {
+    m.visual_valid = pf.visual.valid;
+    m.visual_tracked = static_cast<uint32_t>(std::max(0, pf.visual.tracked));
+    m.visual_inliers = static_cast<uint32_t>(std::max(0, pf.visual.inliers));
+    m.visual_residual_px = pf.visual.residual_px;
+  }
 }
 
 void ZeroNonFinite(steadiface::StabilizerState* out) {
@@ -485,7 +492,7 @@ void ZeroNonFinite(steadiface::StabilizerState* out) {
   for (double* v : {&m.energy_fit, &m.energy_distortion, &m.energy_follow, &m.energy_rotation,
                     &m.energy_translation, &m.energy_protrusion, &m.mean_angular_speed,
                     &m.face_shape_residual, &m.face_spread_ratio, &m.face_jump,
-                    &m.face_appearance, &m.imu_offset_applied_s,
+                    &m.face_appearance, &m.imu_offset_applied_s, &m.visual_residual_px,
                     &m.layer_blend, &m.layer_blend_step, &m.band_px, &m.layer_offset_px,
                     &m.layer_offset_capped_px, &m.layer_shift_px, &m.layer_keep,
                     &m.min_cell_ratio, &m.matte_mean, &m.uncovered_px, &m.plate_share,

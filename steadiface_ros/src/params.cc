@@ -239,9 +239,13 @@ void ReadRosLayer(Reader& r, steadiface::PipelineOptions* po, WrapperOptions* wo
                        : po->landmark_source == LandmarkSource::kNone   ? "none"
                                                                         : "dlib";
   r.Choice("landmark_source", &source);
-  std::string rotation = po->rotation_source == RotationSource::kVisual ? "visual" : "imu";
+  std::string rotation = po->rotation_source == RotationSource::kVisual ? "visual"
+                         : po->rotation_source == RotationSource::kAuto ? "auto"
+                                                                         : "imu";
   r.Choice("rotation_source", &rotation);
-  po->rotation_source = rotation == "visual" ? RotationSource::kVisual : RotationSource::kImu;
+  po->rotation_source = rotation == "visual" ? RotationSource::kVisual
+                        : rotation == "auto" ? RotationSource::kAuto
+                                             : RotationSource::kImu;
   po->landmark_source = source == "topic"  ? LandmarkSource::kExternal
                         : source == "none" ? LandmarkSource::kNone
                                            : LandmarkSource::kDlib;

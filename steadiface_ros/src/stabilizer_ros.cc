@@ -302,13 +302,17 @@ void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
               steadiface::SampleResultName(static_cast<steadiface::SampleResult>(i)),
           w.timeline.samples[i]);
   }
-  if (w.visual_rotation) {
+  const bool auto_source = w.rotation_source == "auto";
+  const std::string instead =
+      auto_source ? ": the rotation comes from the video" : ": frames are not stabilized";
+  s.add("frames rotated from the video", w.counters.from_video);
+  if (w.rotation_source == "visual") {
     s.summary(diagnostic_msgs::DiagnosticStatus::OK,
               "not used: rotation_source is visual (see \"rotation source\")");
   } else if (!imu_seen_ && since > wrapper_options_.scheduler.imu_timeout_s) {
-    s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no IMU data: frames are not stabilized");
+    s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "no IMU data" + instead);
   } else if (since > wrapper_options_.scheduler.imu_timeout_s) {
-    s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "IMU stopped");
+    s.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "IMU stopped" + instead);
   } else if (w.counters.imu_rejected > 0 || w.counters.imu_gaps > 0 || w.counters.extrapolated > 0) {
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
               "IMU rejects, gaps or extrapolated frames (see values)");
@@ -319,7 +323,9 @@ void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
 
 void StabilizerRos::DiagRotationSource(diagnostic_updater::DiagnosticStatusWrapper& s) {
   const WrapperStatus w = wrapper_->Status();
-  if (!w.visual_rotation) {
+  s.add("rotation_source", w.rotation_source);
+  s.add("frames rotated from the video", w.counters.from_video);
+  if (w.rotation_source == "imu" || (w.rotation_source == "auto" && !w.last_from_video)) {
     s.add("source", "imu");
     s.summary(diagnostic_msgs::DiagnosticStatus::OK, "imu");
     return;
@@ -329,14 +335,15 @@ void StabilizerRos::DiagRotationSource(diagnostic_updater::DiagnosticStatusWrapp
   s.add("inliers", w.visual.inliers);
   s.add("residual [px]", w.visual.residual_px);
   s.add("time [ms]", w.visual.ms);
+  const std::string what = w.rotation_source == "auto" ? "visual (no IMU data)" : "visual";
   if (!w.pipeline_ready) {
-    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "visual: waiting for the first image");
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, what + ": waiting for the first image");
   } else if (w.visual.valid) {
-    s.summary(diagnostic_msgs::DiagnosticStatus::OK, "visual");
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, what);
   } else {
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-              "visual: too few features fit one rotation (texture, darkness, a crowd); "
-              "holding the camera still");
+              what + ": too few features fit one rotation (texture, darkness, a crowd); "
+                     "holding the camera still");
   }
 }
 

@@ -292,10 +292,18 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   cv::Mat image;
   if (!ToCheckedImage(p, &image)) return;
   const steadiface::Time stamp = ToCoreTime(p.image->header.stamp);
-  // The visual rotation source needs no IMU: every frame is processed.
-  const bool visual = options_.rotation_source == steadiface::RotationSource::kVisual;
-  const steadiface::FrameDisposition d =
-      visual ? steadiface::FrameDisposition::kProcess : scheduler_.Dispose(stamp, late);
+  // The visual rotation source needs no IMU: every frame is processed. In
+  // auto, a frame the gyro does not cover takes its rotation from the video
+  // instead of passing through, being extrapolated or dropped.
+  using steadiface::FrameDisposition;
+  using steadiface::RotationSource;
+  FrameDisposition d = options_.rotation_source == RotationSource::kVisual
+                           ? FrameDisposition::kProcess
+                           : scheduler_.Dispose(stamp, late);
+  if (options_.rotation_source == RotationSource::kAuto) {
+    pipeline_->SetImuMissing(d != FrameDisposition::kProcess);
+    d = FrameDisposition::kProcess;
+  }
   if (d == steadiface::FrameDisposition::kNoImu) {
     PublishPassthrough(p, image, started);
     return;
@@ -547,7 +555,11 @@ void StabilizerWrapper::PublishDebugImage(const steadiface::PipelineFrame& frame
 void StabilizerWrapper::UpdateStatus(const steadiface::PipelineFrame& frame,
                                      const std_msgs::Header& in_header) {
   status_.gyro_video_check = frame.gyro_video_check;
-  status_.visual = frame.visual;
+  status_.last_from_video = frame.rotation_from_video;
+  if (frame.rotation_from_video) {
+    status_.visual = frame.visual;
+    ++counters_.from_video;
+  }
   status_.imu_offset_applied_s = frame.imu_offset_applied_s;
   status_.face_state = frame.face.state;
   status_.face_failure = steadiface::FaceFailureName(frame.face.failure);
@@ -567,7 +579,9 @@ WrapperStatus StabilizerWrapper::Status() const {
   s.counters = counters_;
   s.pipeline_ready = pipeline_ != nullptr;
   s.imu_ever = scheduler_.have_gyro();
-  s.visual_rotation = options_.rotation_source == steadiface::RotationSource::kVisual;
+  s.rotation_source = options_.rotation_source == steadiface::RotationSource::kVisual ? "visual"
+                      : options_.rotation_source == steadiface::RotationSource::kAuto ? "auto"
+                                                                                       : "imu";
   if (pipeline_) {
     s.timeline = pipeline_->timeline().stats();
     s.stabilizer = pipeline_->stabilizer().stats();

@@ -568,6 +568,7 @@ TEST(WrapperTest, ImuGapIsWarnedAndFramesExtrapolatedOrDropped) {
     wo.scheduler.late_frame_policy = policy;
     steadiface::PipelineOptions po = Options();
     po.imu.max_extrapolation_s = 0.05;
+    po.rotation_source = steadiface::RotationSource::kImu;  // auto: the video fills gaps
     StabilizerWrapper w(po, wo, &sink);
     const Stream& st = TestStream();
     const ros::Time gap_from = st.images[20]->header.stamp, gap_to = st.images[24]->header.stamp;
@@ -590,7 +591,9 @@ TEST(WrapperTest, ImuGapIsWarnedAndFramesExtrapolatedOrDropped) {
 
 TEST(WrapperTest, NoImuPassesFramesThroughUnstabilized) {
   Sink sink;
-  StabilizerWrapper w(Options(), WrapperOptions(), &sink);
+  steadiface::PipelineOptions imu_only = Options();
+  imu_only.rotation_source = steadiface::RotationSource::kImu;
+  StabilizerWrapper w(imu_only, WrapperOptions(), &sink);
   const Stream& st = TestStream();
   for (const auto& img : st.images) {
     w.OnImage(img, st.info, img->header.stamp);
@@ -605,7 +608,7 @@ TEST(WrapperTest, NoImuPassesFramesThroughUnstabilized) {
   Sink sink2;
   WrapperOptions wo;
   wo.passthrough_without_imu = false;
-  StabilizerWrapper w2(Options(), wo, &sink2);
+  StabilizerWrapper w2(imu_only, wo, &sink2);
   for (const auto& img : st.images) w2.OnImage(img, st.info, img->header.stamp);
   w2.Flush();
   EXPECT_TRUE(sink2.images.empty());
@@ -642,7 +645,9 @@ TEST(WrapperTest, WithoutAnImuTheVideoGivesTheRotation) {
   EXPECT_EQ(sink.images.size(), st.images.size());
   EXPECT_EQ(w.Status().counters.passthrough, 0u);
   EXPECT_EQ(sink.errors["no_imu"], 0);
-  EXPECT_TRUE(w.Status().visual_rotation);
+  EXPECT_EQ(w.Status().rotation_source, "visual");
+  EXPECT_TRUE(w.Status().last_from_video);
+  EXPECT_EQ(w.Status().counters.from_video, st.images.size());
   EXPECT_TRUE(w.Status().visual.valid);
   EXPECT_GE(w.Status().visual.inliers, 20);
   ExpectAllFinite(sink);
@@ -657,6 +662,60 @@ TEST(WrapperTest, WithoutAnImuTheVideoGivesTheRotation) {
   // (measured: 0.0019 rad).
   std::cout << "[ frame-to-frame turn ] RMS " << std::sqrt(ref / b.size()) << " rad (gyro), error of the video's " << std::sqrt(err / a.size()) << " rad\n";
   EXPECT_LT(std::sqrt(err / a.size()), 0.2 * std::sqrt(ref / b.size()));
+}
+
+// rotation_source auto: with a healthy IMU exactly what imu gives; an IMU
+// that drops out for 0.6 s mid-stream: every frame is still stabilized, the
+// frames without IMU data by the video, and the virtual camera's largest
+// per-frame turn at the two hand-overs is no larger than elsewhere.
+TEST(WrapperTest, AutoBridgesAnImuDropoutWithTheVideo) {
+  const Stream& st = TestStream();
+  auto run = [&](steadiface::RotationSource source, bool dropout, Sink* sink) {
+    steadiface::PipelineOptions o = Options();
+    o.rotation_source = source;
+    StabilizerWrapper w(o, WrapperOptions(), sink);
+    const ros::Time t0 = st.images.front()->header.stamp;
+    Feed(&w, st, 0, -1, [&](sensor_msgs::Imu* m) {
+      const double t = (m->header.stamp - t0).toSec();
+      if (dropout && t > 0.6 && t < 1.2) m->angular_velocity.x = kNaN;  // lost: rejected
+    });
+    return w.Status();
+  };
+  Sink imu, healthy;
+  run(steadiface::RotationSource::kImu, false, &imu);
+  const WrapperStatus h = run(steadiface::RotationSource::kAuto, false, &healthy);
+  ASSERT_EQ(healthy.states.size(), imu.states.size());
+  for (size_t i = 0; i < imu.states.size(); ++i) {
+    EXPECT_EQ(healthy.states[i].virtual_rotation, imu.states[i].virtual_rotation) << i;
+    EXPECT_EQ(healthy.states[i].principal_offset, imu.states[i].principal_offset) << i;
+  }
+  EXPECT_EQ(h.counters.from_video, 0u);
+  Sink gap;
+  const WrapperStatus g = run(steadiface::RotationSource::kAuto, true, &gap);
+  EXPECT_EQ(gap.states.size(), st.images.size()) << "a frame was not stabilized";
+  EXPECT_EQ(g.counters.passthrough, 0u);
+  EXPECT_GT(g.counters.from_video, 10u);
+  EXPECT_LT(g.counters.from_video, st.images.size() / 2);
+  ExpectAllFinite(gap);
+  // The virtual camera's turn from frame to frame, and where the source
+  // changed.
+  std::vector<double> turn;
+  for (size_t i = 1; i < gap.states.size(); ++i) {
+    const auto& a = gap.states[i - 1].virtual_rotation;
+    const auto& b = gap.states[i].virtual_rotation;
+    turn.push_back(Eigen::Quaterniond(a.w, a.x, a.y, a.z)
+                       .angularDistance(Eigen::Quaterniond(b.w, b.x, b.y, b.z)));
+  }
+  double steady = 0.0, handover = 0.0;
+  for (size_t i = 0; i < turn.size(); ++i) {
+    const bool switched = gap.states[i + 1].rotation_source != gap.states[i].rotation_source;
+    (switched ? handover : steady) = std::max(switched ? handover : steady, turn[i]);
+  }
+  std::cout << "[ IMU dropout ] " << g.counters.from_video << " of " << gap.states.size()
+            << " frames rotated by the video; largest virtual turn per frame: " << steady
+            << " rad elsewhere, " << handover << " rad at the hand-overs\n";
+  EXPECT_GT(handover, 0.0);
+  EXPECT_LE(handover, std::max(steady, 1e-9) * 1.0 + 1e-9);
 }
 
 sensor_msgs::ImagePtr Copy(const sensor_msgs::ImagePtr& m) {

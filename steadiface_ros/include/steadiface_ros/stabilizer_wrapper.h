@@ -80,6 +80,7 @@ struct WrapperCounters {
   uint64_t dropped_pipeline_error = 0;  ///< stabilizer/warp refused the frame
   uint64_t extrapolated = 0;            ///< processed with extrapolated gyro
   uint64_t passthrough = 0;             ///< published unstabilized (no IMU)
+  uint64_t from_video = 0;              ///< rotation from the video (visual, or auto without IMU)
   uint64_t imu_rejected = 0;            ///< non-finite, implausible, duplicate, out of order
   uint64_t imu_gaps = 0;                ///< gaps longer than imu_gap_warn
   uint64_t time_jumps = 0;              ///< time went backwards: full reset
@@ -118,9 +119,10 @@ struct WrapperStatus {
   std::string landmark_model_error;
   /// The gyro-vs-video check as of the last frame.
   steadiface::GyroVideoCheckResult gyro_video_check;
-  /// rotation_source visual: whether it is on, and the last frame's
-  /// rotation from the video.
-  bool visual_rotation = false;
+  /// rotation_source: "imu", "visual" or "auto"; whether the last frame's
+  /// rotation came from the video, and what the video gave.
+  std::string rotation_source = "imu";
+  bool last_from_video = false;
   steadiface::VisualRotation visual;
   /// The clock offset correction applied on top of imu/time_offset [s].
   double imu_offset_applied_s = 0.0;

@@ -74,8 +74,9 @@ steadiface::Status BagReader::Open(bool info_required) {
             "camera_info_url in a --params file");
       }
       if (w.second != "sensor_msgs/Imu") return Status::Error("no image topic");
-      std::cerr << "steadiface_bag: continuing without IMU: frames pass "
-                   "through unstabilized\n";
+      std::cerr << "steadiface_bag: continuing without IMU: the rotation comes "
+                   "from the video (rotation_source auto or visual), or frames "
+                   "pass through unstabilized (imu)\n";
     } else if (w.second == "sensor_msgs/Image" &&
                it->second == "sensor_msgs/CompressedImage") {
       compressed_ = true;
