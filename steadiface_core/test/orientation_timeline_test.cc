@@ -342,6 +342,39 @@ TEST(OrientationTimelineTest, ResetStartsANewEpoch) {
   EXPECT_EQ(tl.stats().resets, 1u);
 }
 
+// Orientations given outright (the visual rotation source): queries
+// interpolate between them, with the offset correction as for gyro samples,
+// and a gyro sample after them integrates on from the last one.
+TEST(OrientationTimelineTest, OrientationsGivenOutrightAreInterpolatedAndContinued) {
+  OrientationTimeline tl{OrientationTimelineOptions()};
+  const Eigen::Quaterniond a = ExpSO3(Eigen::Vector3d(0.0, 0.1, 0.0));
+  const Eigen::Quaterniond b = ExpSO3(Eigen::Vector3d(0.0, 0.2, 0.0));
+  const Eigen::Vector3d w(0.0, 1.0, 0.0);  // 0.1 rad in 0.1 s
+  ASSERT_EQ(tl.AddOrientation(Time(FromSeconds(1.0)), a, w), SampleResult::kAccepted);
+  ASSERT_EQ(tl.AddOrientation(Time(FromSeconds(1.1)), b, w), SampleResult::kAccepted);
+  EXPECT_EQ(tl.AddOrientation(Time(FromSeconds(1.05)), b, w), SampleResult::kOutOfOrder);
+  EXPECT_EQ(tl.AddOrientation(Time(FromSeconds(1.2)), b, Eigen::Vector3d(kNaN, 0, 0)),
+            SampleResult::kNonFinite);
+  Eigen::Quaterniond q;
+  ASSERT_TRUE(QuerySucceeded(tl.CameraToWorld(Time(FromSeconds(1.05)), &q)));
+  EXPECT_NEAR(AngleBetween(q, ExpSO3(Eigen::Vector3d(0.0, 0.15, 0.0))), 0.0, 1e-9);
+  // A gyro sample 0.1 s later at the same rate: 0.1 rad further.
+  GyroSample g;
+  g.stamp = Time(FromSeconds(1.2));
+  g.angular_velocity = w;
+  ASSERT_EQ(tl.AddSample(g), SampleResult::kAccepted);
+  ASSERT_TRUE(QuerySucceeded(tl.CameraToWorld(Time(FromSeconds(1.2)), &q)));
+  EXPECT_NEAR(AngleBetween(q, ExpSO3(Eigen::Vector3d(0.0, 0.3, 0.0))), 0.0, 1e-9);
+  // With an offset correction, a node given at camera time t is found there.
+  OrientationTimeline c{OrientationTimelineOptions()};
+  c.set_offset_correction(0.01);
+  ASSERT_EQ(c.AddOrientation(Time(FromSeconds(2.0)), a, w), SampleResult::kAccepted);
+  ASSERT_EQ(c.AddOrientation(Time(FromSeconds(2.1)), b, w), SampleResult::kAccepted);
+  EXPECT_EQ(c.newest(), Time(FromSeconds(2.1)));
+  ASSERT_TRUE(QuerySucceeded(c.CameraToWorld(Time(FromSeconds(2.0)), &q)));
+  EXPECT_NEAR(AngleBetween(q, a), 0.0, 1e-9);
+}
+
 TEST(OrientationTimelineTest, OptionsValidation) {
   OrientationTimelineOptions o;
   EXPECT_TRUE(ValidateOrientationTimelineOptions(o).ok());

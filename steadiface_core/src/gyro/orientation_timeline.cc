@@ -126,18 +126,21 @@ SampleResult OrientationTimeline::AddSample(const GyroSample& sample) {
 SampleResult OrientationTimeline::AddOrientation(Time t, const Eigen::Quaterniond& q_wc,
                                                  const Eigen::Vector3d& omega) {
   SampleResult result = SampleResult::kAccepted;
+  const Time stored = t - correction_;
   if (!omega.allFinite() || !q_wc.coeffs().allFinite() || q_wc.norm() < 0.5) {
     result = SampleResult::kNonFinite;
   } else if (omega.norm() > options_.max_angular_rate) {
     result = SampleResult::kImplausibleRate;
-  } else if (!samples_.empty() && t == samples_.back().t) {
+  } else if (!samples_.empty() && stored == samples_.back().t) {
     result = SampleResult::kDuplicateStamp;
-  } else if (!samples_.empty() && t < samples_.back().t) {
+  } else if (!samples_.empty() && stored < samples_.back().t) {
     result = SampleResult::kOutOfOrder;
   }
   ++stats_.samples[static_cast<size_t>(result)];
   if (result != SampleResult::kAccepted) return result;
-  samples_.push_back(Node{t, omega, q_wc.normalized()});
+  // Stored like a gyro sample: a query at camera time t, which reads the
+  // samples at t - correction, finds it.
+  samples_.push_back(Node{stored, omega, q_wc.normalized()});
   Trim();
   return result;
 }

@@ -46,7 +46,7 @@ Status ValidatePipelineOptions(const PipelineOptions& o) {
   if (!s.ok()) return s;
   s = ValidateCompositeOptions(o.composite);
   if (!s.ok()) return s;
-  if (o.rotation_source == RotationSource::kVisual) {
+  if (o.rotation_source != RotationSource::kImu) {
     s = ValidateVisualRotationOptions(o.visual);
     if (!s.ok()) return s;
   }
