@@ -4,8 +4,8 @@
 strictly increasing TF, lower head jitter than the input (ground truth from
 the simulator's CSV sidecar), a reconfigure of w_fit reaching the state
 topic, and the documented diagnostics, one test method each. With
---no-imu: ERROR diagnostic within 2 s and unstabilized frames still
-published; --visual: no IMU, rotation_source visual, stabilized frames
+--no-imu: ERROR diagnostic within 2 s and frames still published, rotated
+by the video (rotation_source auto); --visual: no IMU, rotation_source visual, stabilized frames
 within 1.5 s and the "rotation source" diagnostic saying visual; --layered, --equivalence and --bag-loop run their own cases."""
 import argparse
 import csv
@@ -123,14 +123,19 @@ def BagToolParams():
 
 
 class NoImuTest(unittest.TestCase):
-    """Without IMU: unstabilized frames still published, ERROR within 2 s."""
+    """Without IMU, the default rotation_source auto: frames still published,
+    their rotation from the video, and the gyro ERROR within 2 s."""
 
     @classmethod
     def setUpClass(cls):
         cls.c = Collector(watch_input=True)
 
-    def test_1_frames_pass_through(self):
+    def test_1_frames_are_published_rotated_by_the_video(self):
         self.assertTrue(wait_for(lambda: len(self.c.images) > 0, 40), "no image published without IMU")
+        self.assertTrue(wait_for(lambda: len(self.c.states) > 0, 5), "no stabilized frame without IMU")
+        with self.c.lock:
+            sources = set(st.rotation_source for st in self.c.states)
+        self.assertEqual(sources, {"visual"})
 
     def test_2_gyro_error_within_2_s(self):
         c = self.c
