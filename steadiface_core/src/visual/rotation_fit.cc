@@ -12,6 +12,11 @@ namespace steadiface {
 namespace visual {
 namespace {
 
+// The scene point's bearing in the second frame, Exp(-phi) b1.
+Eigen::Vector3d Moved(const Motion& m, const BearingPair& p) {
+  return ExpSO3(-(p.c * m.head<3>() + p.d * m.tail<3>())) * p.b1;
+}
+
 double ErrorPx(const Motion& omega, const BearingPair& p, double focal_px) {
   return (Predict(omega, p) - p.n2).norm() * focal_px;
 }
@@ -38,8 +43,7 @@ Motion Refine(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
     Eigen::Matrix<double, 6, 1> Jtr = Eigen::Matrix<double, 6, 1>::Zero();
     for (int i : in) {
       const BearingPair& p = pairs[i];
-      const Eigen::Vector3d b2 =
-          ExpSO3(-(p.c * m.head<3>() + p.d * m.tail<3>())) * p.b1;
+      const Eigen::Vector3d b2 = Moved(m, p);
       const Eigen::Vector2d r = b2.head<2>() / b2.z() - p.n2;
       Eigen::Matrix<double, 2, 3> Jp;  // d(x/z, y/z) / d b2
       Jp << 1.0 / b2.z(), 0.0, -b2.x() / (b2.z() * b2.z()), 0.0, 1.0 / b2.z(),
@@ -68,8 +72,7 @@ Motion Refine(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
 }  // namespace
 
 Eigen::Vector2d Predict(const Motion& m, const BearingPair& p) {
-  const Eigen::Vector3d phi = p.c * m.head<3>() + p.d * m.tail<3>();
-  const Eigen::Vector3d b2 = ExpSO3(-phi) * p.b1;
+  const Eigen::Vector3d b2 = Moved(m, p);
   return b2.head<2>() / b2.z();
 }
 

@@ -205,13 +205,9 @@ Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
   const auto t0 = std::chrono::steady_clock::now();
   *out = VisualRotation();
   out->stamp = stamp;
+  Status s = CheckGray(gray);
+  if (!s.ok()) return s;
   const CameraIntrinsics& k = model_.intrinsics();
-  if (gray.empty() || gray.type() != CV_8UC1 || gray.cols != k.width ||
-      gray.rows != k.height) {
-    return Status::Error("visual rotation: need an 8-bit grey " +
-                         std::to_string(k.width) + "x" +
-                         std::to_string(k.height) + " image");
-  }
   if (!prev_.empty() && stamp <= prev_stamp_)
     Reset();  // time went back: start over
   const cv::Mat small = Copy(gray);
@@ -224,8 +220,6 @@ Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
         timing_.RowTime(prev_stamp_, mid) +
         (timing_.RowTime(stamp, mid) - timing_.RowTime(prev_stamp_, mid)) / 2;
     Track(small, mask, stamp, out);
-  } else {
-    prev_points_.clear();
   }
   Refill(small, mask);
   prev_ = small;
@@ -246,11 +240,18 @@ cv::Mat VisualRotationEstimator::Copy(const cv::Mat& gray) const {
   return small;
 }
 
-Status VisualRotationEstimator::Remember(const cv::Mat& gray, Time stamp) {
+Status VisualRotationEstimator::CheckGray(const cv::Mat& gray) const {
   const CameraIntrinsics& k = model_.intrinsics();
   if (gray.empty() || gray.type() != CV_8UC1 || gray.cols != k.width || gray.rows != k.height) {
-    return Status::Error("visual rotation: need an 8-bit grey image of the camera's size");
+    return Status::Error("visual rotation: need an 8-bit grey " + std::to_string(k.width) + "x" +
+                         std::to_string(k.height) + " image");
   }
+  return Status::Ok();
+}
+
+Status VisualRotationEstimator::Remember(const cv::Mat& gray, Time stamp) {
+  Status s = CheckGray(gray);
+  if (!s.ok()) return s;
   prev_ = Copy(gray);
   prev_stamp_ = stamp;
   prev_points_.clear();

@@ -75,7 +75,7 @@ struct VisualRotation {
 /// The camera's rotation from the video alone, for a camera without an IMU
 /// (or while it drops out): background features tracked from the previous
 /// frame (KLT), the subject left out, and a rotation-only motion fitted
-/// robustly (RANSAC on pairs of features, then Gauss-Newton on the
+/// robustly (RANSAC on triples of features, then Gauss-Newton on the
 /// inliers), so that people and objects moving through the view are
 /// outliers. The angular velocity varies linearly in time across the pair
 /// (a hand's shake changes it within a frame), and each feature moves by
@@ -112,6 +112,7 @@ class VisualRotationEstimator {
              VisualRotation* out);
   cv::Mat SubjectMask(const cv::Size& size, const cv::Rect2d& face) const;
   cv::Mat Copy(const cv::Mat& gray) const;  // the tracking copy of a frame
+  Status CheckGray(const cv::Mat& gray) const;  // 8-bit grey, the camera's size
 
   const CameraModel model_;
   const RowTiming timing_;
