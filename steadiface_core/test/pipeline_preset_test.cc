@@ -1,6 +1,7 @@
 // The full pipeline on rendered presets against gyro-only and the input:
 // head and background jitter, the crop, a face leaving and coming back, a
 // brightness change, no undefined pixels.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <iostream>
@@ -264,6 +265,79 @@ TEST(PipelinePresetTest, EveryPresetHasNoUndefinedPixels) {
     EXPECT_EQ(r.gyro.undefined_fraction, 0.0) << p;
     EXPECT_GT(r.full.distortion, 0.9) << p;
   }
+}
+
+}  // namespace
+}  // namespace steadiface
+
+namespace steadiface {
+namespace {
+
+eval::Score RunCrop(const sim::Simulator& s, eval::Method method, CropMode mode) {
+  PipelineOptions po = eval::OptionsFor(s, method);
+  po.crop.mode = mode;
+  std::unique_ptr<eval::Scorecard> card;
+  EXPECT_TRUE(eval::MakeScorecard(s, po, &card).ok());
+  const Status st = eval::RunMethod(s, method, po, false, card.get(), nullptr);
+  EXPECT_TRUE(st.ok()) << st.message();
+  return card->Compute();
+}
+
+// The dynamic crop (output/crop dynamic): on a camera at rest the view
+// stays at its widest from the start; under the recorded running shake it
+// closes to the fixed crop's margin, and no output pixel is ever undefined.
+TEST(PipelinePresetTest, TheDynamicCropOpensOnACalmCameraAndClosesUnderShake) {
+  auto still = MakeSimulator("still");
+  const eval::Score calm = RunCrop(*still, eval::Method::kSteadiface, CropMode::kDynamic);
+  EXPECT_GE(calm.kept_width_min, 0.93);
+  EXPECT_EQ(calm.undefined_fraction, 0.0);
+  auto run = MakeSimulator("run", [](sim::SimulatorOptions* o) { o->duration_s = 4.0; });
+  const eval::Score fixed = RunCrop(*run, eval::Method::kGyroOnly, CropMode::kFixed);
+  const eval::Score dynamic = RunCrop(*run, eval::Method::kGyroOnly, CropMode::kDynamic);
+  std::cout << "[ dynamic crop ] still: kept " << calm.kept_width_mean << " (least "
+            << calm.kept_width_min << "); run, gyro-only: kept " << dynamic.kept_width_mean
+            << " (least " << dynamic.kept_width_min << "), background "
+            << dynamic.visible_background_jitter_px << " px (fixed "
+            << fixed.visible_background_jitter_px << "), largest step "
+            << dynamic.kept_width_max_step << "\n";
+  EXPECT_NEAR(fixed.kept_width_min, 0.7, 1e-12);  // 0.7 throughout
+  EXPECT_NEAR(fixed.kept_width_mean, 0.7, 1e-12);
+  EXPECT_LE(dynamic.kept_width_min, 0.72);
+  EXPECT_GE(dynamic.kept_width_min, 0.7 - 1e-12);
+  EXPECT_EQ(dynamic.undefined_fraction, 0.0);
+  // A frame's zoom step stays within the tightening rate, 0.15/s x 2 sides.
+  EXPECT_LE(dynamic.kept_width_max_step, 2 * 0.15 / 30 + 1e-9);
+}
+
+// The stabilized camera_info follows the crop: its focal length in output
+// pixels is the fixed crop's times 0.7 / kept width, its centre stays.
+TEST(PipelinePresetTest, TheOutputIntrinsicsFollowTheDynamicCrop) {
+  auto s = MakeSimulator("walk");
+  PipelineOptions po = eval::OptionsFor(*s, eval::Method::kGyroOnly);
+  po.crop.mode = CropMode::kDynamic;
+  std::unique_ptr<Pipeline> p;
+  ASSERT_TRUE(Pipeline::Create(s->intrinsics(), po, &p).ok());
+  OutputGeometry fixed;
+  ASSERT_TRUE(OutputGeometry::Create(p->camera_model(), po.warp.output, &fixed).ok());
+  const CameraIntrinsics k0 = fixed.VirtualIntrinsics(Eigen::Vector2d::Zero());
+  const cv::Mat frame(s->intrinsics().height, s->intrinsics().width, CV_8UC1, cv::Scalar(0));
+  size_t g = 0;
+  double least = 1.0, most = 0.0;
+  for (int i = 0; i < 60; ++i) {
+    const Time stamp = s->Truth(i).stamp;
+    eval::FeedGyroForFrame(*s, stamp, po.imu.imu_time_offset_s, p.get(), &g);
+    PipelineFrame out;
+    ASSERT_TRUE(p->ProcessFrame(frame, stamp, nullptr, 0.0, &out).ok());
+    const double kept = 1.0 - 2.0 * out.crop.crop_ratio;
+    least = std::min(least, kept);
+    most = std::max(most, kept);
+    EXPECT_NEAR(out.output_intrinsics.fx, k0.fx * 0.7 / kept, 1e-9 * k0.fx) << i;
+    EXPECT_NEAR(out.output_intrinsics.fy, k0.fy * 0.7 / kept, 1e-9 * k0.fy) << i;
+    EXPECT_EQ(out.output_intrinsics.width, k0.width);
+    EXPECT_TRUE(out.crop.dynamic);
+    EXPECT_GE(out.crop.shake_need, 0.0);
+  }
+  EXPECT_GT(most - least, 0.02) << "the crop should have moved on walk";
 }
 
 }  // namespace

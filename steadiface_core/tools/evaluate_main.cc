@@ -165,6 +165,8 @@ int Usage() {
                "         at most once per S while no face is locked; 0 = every frame)\n"
                "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
                "         shows a 30 px face)\n"
+               "       [--crop-mode fixed|dynamic] (output.crop: the fixed crop ratio, or the\n"
+               "         dynamic crop between --widest R and it; default: the package's)\n"
                "       [--rotation-source imu|visual] (visual: the camera's rotation from\n"
                "         the video, the IMU unused)\n"
                "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
@@ -273,6 +275,12 @@ int main(int argc, char** argv) {
   double search_interval = NAN;  // face.search_interval [s]; NaN: the default
   double head_distance = NAN;    // the subject's distance [m]; NaN: the preset's
   bool visual_rotation = false;  // --rotation-source visual
+  int crop_mode = -1;            // --crop-mode: 0 fixed, 1 dynamic; -1: the default
+  double widest = NAN;           // --widest: output.dynamic.widest_crop_ratio
+  bool start_tight = false;      // --start-tight: output.dynamic.start_wide false
+  double shake_hz = NAN, headroom = NAN;  // output.dynamic.shake_path_hz, headroom
+  // output.dynamic.max_widen_rate, max_tighten_rate, max_accel (NaN: default)
+  double widen_rate = NAN, tighten_rate = NAN, zoom_accel = NAN;
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
   double subject_reach = 0.0;    // stabilizer.subject_reach [jaw widths]; 0: off
@@ -298,6 +306,14 @@ int main(int argc, char** argv) {
     visual_rotation = v == "visual";
     return v == "imu" || v == "visual";
   });
+  cl.Value("--crop-mode", "fixed or dynamic", [&](const std::string& v) {
+    crop_mode = v == "dynamic" ? 1 : 0;
+    return v == "fixed" || v == "dynamic";
+  });
+  cl.Double("--widest", &widest).Flag("--start-tight", &start_tight);
+  cl.Double("--shake-hz", &shake_hz).Double("--headroom", &headroom);
+  cl.Double("--widen-rate", &widen_rate).Double("--tighten-rate", &tighten_rate);
+  cl.Double("--zoom-accel", &zoom_accel);
   cl.Double("--head-w-stay", &head_w_stay).Double("--head-d-ref", &head_d_ref);
   cl.Double("--subject-reach", &subject_reach).Double("--reach-lowpass", &reach_lowpass);
   cl.Double("--reach-hold", &reach_hold).Flag("--feasible-set", &feasible_set);
@@ -480,6 +496,16 @@ int main(int argc, char** argv) {
                                                         : Method::kSteadiface;
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
+        if (crop_mode >= 0) {
+          po.crop.mode = crop_mode == 1 ? steadiface::CropMode::kDynamic : steadiface::CropMode::kFixed;
+        }
+        if (std::isfinite(widest)) po.crop.widest_crop_ratio = widest;
+        if (start_tight) po.crop.start_wide = false;
+        if (std::isfinite(shake_hz)) po.crop.shake_path_hz = shake_hz;
+        if (std::isfinite(headroom)) po.crop.headroom = headroom;
+        if (std::isfinite(widen_rate)) po.crop.max_widen_rate = widen_rate;
+        if (std::isfinite(tighten_rate)) po.crop.max_tighten_rate = tighten_rate;
+        if (std::isfinite(zoom_accel)) po.crop.max_widen_accel = zoom_accel;
         if (std::isfinite(search_interval)) po.face.search_interval_s = search_interval;
         if (visual_rotation) po.rotation_source = steadiface::RotationSource::kVisual;
         if (std::isfinite(head_w_stay)) po.stabilizer.head.w_stay = head_w_stay;
@@ -530,7 +556,7 @@ int main(int argc, char** argv) {
           std::ofstream csv(out_dir + "/traj_" + preset + "_" + name + ".csv");
           csv << "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
                  "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty,"
-                 "w_fit,protrusion_search_s,previous_warp\n";
+                 "crop_ratio,crop_need,w_fit,protrusion_search_s,previous_warp\n";
           // The stabilizer's own record (nan for "none"): the w_f in
           // effect, how far the protrusion search moved towards the real
           // pose (-1: it did not run) and whether the previous warp was reused.
@@ -542,7 +568,7 @@ int main(int argc, char** argv) {
                 << "," << p.background_out.y() << "," << p.virtual_angle[0] << ","
                 << p.virtual_angle[1] << "," << p.virtual_angle[2] << "," << p.real_angle[0]
                 << "," << p.real_angle[1] << "," << p.real_angle[2] << "," << p.offset.x()
-                << "," << p.offset.y();
+                << "," << p.offset.y() << "," << p.crop_ratio << "," << p.crop_need;
             if (i < stab_frames.size()) {
               const steadiface::StabilizerFrame& f = stab_frames[i];
               csv << "," << f.weights.fit << ","
@@ -608,6 +634,10 @@ int main(int argc, char** argv) {
            << ", \"head_stability\": " << jnum(sc.head_stability)
            << ", \"background_stability\": " << jnum(sc.background_stability)
            << ", \"cropping\": " << jnum(sc.cropping) << ", \"distortion\": " << jnum(sc.distortion)
+           << ", \"kept_width_mean\": " << jnum(sc.kept_width_mean)
+           << ", \"kept_width_min\": " << jnum(sc.kept_width_min)
+           << ", \"kept_width_max_step\": " << jnum(sc.kept_width_max_step)
+           << ", \"kept_width_rms_accel\": " << jnum(sc.kept_width_rms_accel)
            << ", \"undefined_fraction\": " << jnum(sc.undefined_fraction)
            << ", \"face_fraction\": " << jnum(face_fraction)
            << ", \"visible_background_jitter_px\": " << jnum(sc.visible_background_jitter_px)

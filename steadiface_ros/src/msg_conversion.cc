@@ -434,6 +434,11 @@ void FillLayers(const steadiface::PipelineFrame& pf, steadiface::StabilizerState
   m.background_rotation = ToMsg(f.background.R_v);
   m.background_principal_offset = {f.background.t.x(), f.background.t.y()};
   m.warp_mode = pf.layered.active ? "layered" : pf.composite.active ? "composite" : "global";
+  m.crop_mode = pf.crop.dynamic ? "dynamic" : "fixed";
+  m.crop_ratio = pf.crop.crop_ratio;
+  m.crop_target = pf.crop.target;
+  m.crop_shake_need = pf.crop.shake_need;
+  m.crop_solved_need = pf.crop.solved_need;
   if (pf.composite.active) {
     const steadiface::CompositeReport& c = pf.composite.report;
     m.layer_blend = pf.composite.region.blend;

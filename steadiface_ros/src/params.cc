@@ -396,6 +396,23 @@ void ReadOutputAndWarp(Reader& r, steadiface::WarpOptions* w) {
   if (!ms.ok()) r.Error("parameter 'warp/mode': " + ms.message());
 }
 
+void ReadCrop(Reader& r, steadiface::DynamicCropOptions* c) {
+  std::string mode = steadiface::CropModeName(c->mode);
+  r.Choice("output/crop", &mode);
+  const Status ms = steadiface::ParseCropMode(mode, &c->mode);
+  if (!ms.ok()) r.Error("parameter 'output/crop': " + ms.message());
+  r.Num("output/dynamic/widest_crop_ratio", &c->widest_crop_ratio);
+  r.Num("output/dynamic/headroom", &c->headroom);
+  r.Num("output/dynamic/extra", &c->extra);
+  r.Num("output/dynamic/memory", &c->memory_s);
+  r.Num("output/dynamic/max_widen_rate", &c->max_widen_rate);
+  r.Num("output/dynamic/max_widen_accel", &c->max_widen_accel);
+  r.Num("output/dynamic/max_tighten_rate", &c->max_tighten_rate);
+  r.Num("output/dynamic/max_tighten_accel", &c->max_tighten_accel);
+  r.Num("output/dynamic/shake_path_hz", &c->shake_path_hz);
+  r.Bool("output/dynamic/start_wide", &c->start_wide);
+}
+
 void ReadLayered(Reader& r, steadiface::LayeredWarpOptions* lw) {
   r.Int("warp/layered/mesh_cols", &lw->mesh_cols);
   r.Int("warp/layered/mesh_rows", &lw->mesh_rows);
@@ -474,6 +491,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   ReadDynamicWeights(r, &po->stabilizer.dynamic);
   ReadSolverAndStabilizer(r, &po->stabilizer);
   ReadOutputAndWarp(r, &po->warp);
+  ReadCrop(r, &po->crop);
   ReadLayered(r, &po->warp.layered);
   ReadComposite(r, &po->composite);
   ReadGyroVideoCheck(r, &po->gyro_video_check);

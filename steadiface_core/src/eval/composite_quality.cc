@@ -86,6 +86,7 @@ Status CompositeQuality::Add(int index, const Pipeline& pipeline, const Pipeline
                              const cv::Mat& input) {
   const Compositor* c = pipeline.compositor();
   if (c == nullptr || f.output.empty()) return Status::Ok();
+  warper_->SetCropRatio(f.crop.crop_ratio);
   cv::Mat scene, alpha, truth8, scene_out;
   Status s = sim_.RenderTruthLayers(index, &scene, &alpha);
   const StabilizerFrame::LayerPose& b = f.stabilizer.background;

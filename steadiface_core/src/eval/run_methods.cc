@@ -1,5 +1,7 @@
 #include "steadiface_core/eval/run_methods.h"
 
+#include <algorithm>
+
 namespace steadiface {
 namespace eval {
 
@@ -56,6 +58,8 @@ FrameWarp MakeFrameWarp(const PipelineFrame& out, const Pipeline& p, bool render
   w.t = out.stabilizer.t;
   w.rows = out.stabilizer.rows;
   w.has_head_target = out.stabilizer.has_target;
+  w.crop_ratio = out.crop.crop_ratio;
+  w.crop_need = std::max(out.crop.shake_need, out.crop.solved_need);
   w.head_target = out.stabilizer.H;
   const bool layered = p.options().warp.mode == WarpMode::kLayered;
   if (p.options().warp.mode == WarpMode::kComposite) {

@@ -152,8 +152,9 @@ Scorecard::Scorecard(const sim::Simulator& sim, const CameraModel& model,
     : sim_(sim),
       model_(model),
       output_(output),
-      protrusion_(model, output, 16),
-      options_(options) {
+      options_(options),
+      frame_output_(output),
+      frame_protrusion_(model, output, 16) {
   // Far-background directions: a grid over the views the camera sweeps
   // (several along a pan); each is scored on its longest in-view run.
   const double T = sim.options().duration_s;
@@ -213,7 +214,7 @@ bool Scorecard::MapToOutput(const FrameWarp& w, const Eigen::Vector2d& p,
                           w.rows.At(p.y()), &V)) {
         return false;
       }
-      *out = output_.VirtualToOutputPixel(V);
+      *out = frame_output_.VirtualToOutputPixel(V);
       return true;
     }
   }
@@ -222,7 +223,7 @@ bool Scorecard::MapToOutput(const FrameWarp& w, const Eigen::Vector2d& p,
 
 bool Scorecard::CompositeCovers(int index, const FrameWarp& w, const Eigen::Vector2d& o) const {
   // The direction the subject layer shows at o, and where it is in the input.
-  const LayerView v = OutputView(output_, w.R_v, w.t);
+  const LayerView v = OutputView(frame_output_, w.R_v, w.t);
   const Eigen::Vector3d d = v.R.conjugate() * (v.K.inverse() * o.homogeneous());
   Eigen::Vector2d px;
   const CameraIntrinsics& ki = sim_.intrinsics();
@@ -232,8 +233,16 @@ bool Scorecard::CompositeCovers(int index, const FrameWarp& w, const Eigen::Vect
 
 void Scorecard::Add(int index, const FrameWarp& w) {
   const sim::SimTruth truth = sim_.Truth(index);
+  const double r = std::isfinite(w.crop_ratio) ? w.crop_ratio : output_.crop_ratio();
+  if (r != frame_output_.crop_ratio()) {
+    frame_output_ = output_.WithCropRatio(r);
+    frame_protrusion_ = ProtrusionGeometry(model_, frame_output_, 16);
+  }
+  kept_width_.push_back(w.kind == FrameWarp::Kind::kIdentity ? 1.0 : 1.0 - 2.0 * r);
   Sample s;
   s.t = ToSeconds(truth.stamp);
+  s.crop_ratio = r;
+  s.crop_need = w.crop_need;
   s.head_in = truth.head_px;
   FrameWarp subject = w;  // the head: the subject layer's pose
   if (w.kind == FrameWarp::Kind::kComposite) subject.kind = FrameWarp::Kind::kPose;
@@ -252,7 +261,7 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     if (k == 13) s.background_out = o;  // centre of the middle view
   }
   if (w.kind != FrameWarp::Kind::kIdentity) identity_ = false;
-  head_target_out_.push_back(w.has_head_target ? output_.VirtualToOutputPixel(w.head_target)
+  head_target_out_.push_back(w.has_head_target ? frame_output_.VirtualToOutputPixel(w.head_target)
                                                : Eigen::Vector2d::Constant(NAN));
   AddVisibleBackground(index, w);
   if (w.kind == FrameWarp::Kind::kMesh) AddMesh(index, w);
@@ -376,9 +385,9 @@ bool Scorecard::Undefined(const FrameWarp& w, Sample* s) const {
     }
   }
   if (w.kind == FrameWarp::Kind::kPose || w.kind == FrameWarp::Kind::kComposite) {
-    undefined = !protrusion_.Check(w.R_v, w.t, w.rows, 0.0).defined;
+    undefined = !frame_protrusion_.Check(w.R_v, w.t, w.rows, 0.0).defined;
     if (w.kind == FrameWarp::Kind::kComposite) {
-      undefined = undefined || !protrusion_.Check(w.R_b, w.t_b, w.rows, 0.0).defined;
+      undefined = undefined || !frame_protrusion_.Check(w.R_b, w.t_b, w.rows, 0.0).defined;
     }
     const Eigen::Vector3d v = LogSO3(w.R_v), r = LogSO3(w.rows.Middle());
     for (int i = 0; i < 3; ++i) {
@@ -436,13 +445,33 @@ Score Scorecard::Compute() const {
   const size_t min_run = static_cast<size_t>(std::max(16.0, fps));  // >= 1 s
   ComputeBackground(fps, min_run, diag, &sc);
   ComputeMeshFigures(fps, &sc);
-  sc.cropping = pose ? std::pow(1.0 - 2.0 * output_.crop_ratio(), 2.0) : 1.0;
+  ComputeCrop(pose, &sc);
   sc.distortion = *std::min_element(distortion_.begin(), distortion_.end());
   sc.undefined_fraction = static_cast<double>(undefined_) / sc.frames;
   for (const auto& st : stages_) {
     sc.stage_ms.push_back({st.first, {Percentile(st.second, 0.5), Percentile(st.second, 0.99)}});
   }
   return sc;
+}
+
+void Scorecard::ComputeCrop(bool pose, Score* sc) const {
+  if (!pose) return;  // the input, uncropped
+  double area = 0.0, sum = 0.0, accel2 = 0.0;
+  sc->kept_width_min = 1.0;
+  for (size_t i = 0; i < kept_width_.size(); ++i) {
+    const double k = kept_width_[i];
+    area += k * k;
+    sum += k;
+    sc->kept_width_min = std::min(sc->kept_width_min, k);
+    if (i >= 1) {
+      sc->kept_width_max_step = std::max(sc->kept_width_max_step, std::abs(k - kept_width_[i - 1]));
+    }
+    if (i >= 2) accel2 += std::pow(k - 2.0 * kept_width_[i - 1] + kept_width_[i - 2], 2.0);
+  }
+  const double n = static_cast<double>(kept_width_.size());
+  sc->cropping = area / n;
+  sc->kept_width_mean = sum / n;
+  sc->kept_width_rms_accel = n > 2 ? std::sqrt(accel2 / (n - 2)) : 0.0;
 }
 
 void Scorecard::ComputeBackground(double fps, size_t min_run, double diag, Score* out) const {

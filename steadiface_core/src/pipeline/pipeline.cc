@@ -6,6 +6,7 @@
 
 #include "steadiface_core/common/grey.h"
 #include "steadiface_core/common/so3.h"
+#include "steadiface_core/view/crop_need.h"
 #include "steadiface_core/warp/mesh_sampler.h"
 
 namespace steadiface {
@@ -50,7 +51,9 @@ Status ValidatePipelineOptions(const PipelineOptions& o) {
     s = ValidateVisualRotationOptions(o.visual);
     if (!s.ok()) return s;
   }
-  return ValidateWarpOptions(o.warp);
+  s = ValidateWarpOptions(o.warp);
+  if (!s.ok()) return s;
+  return ValidateDynamicCropOptions(o.crop);
 }
 
 Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
@@ -58,7 +61,9 @@ Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
       options_(options),
       timing_(options.shutter, model.intrinsics().height),
       timeline_(TimelineOptions(options)),
-      region_(new SubjectRegionTracker(options.warp.layered.region)) {}
+      region_(new SubjectRegionTracker(options.warp.layered.region)),
+      crop_(new DynamicCrop(options.crop, options.warp.output.crop_ratio)),
+      shake_path_(options.crop.shake_path_hz) {}
 
 StabilizerOptions ForWarp(const StabilizerOptions& options, const WarpOptions& warp) {
   StabilizerOptions o = options;
@@ -171,11 +176,14 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     f.gyro_video_check = check_->result();
     f.timings.check_ms = MsSince(t_check);
   }
-  // Stabilizer.
+  // Stabilizer, within this frame's crop.
   const auto t_stab = std::chrono::steady_clock::now();
+  stabilizer_->SetCropRatio(crop_->crop_ratio());
+  warper_->SetCropRatio(crop_->crop_ratio());
   Status s = stabilizer_->Process(stamp, timeline_, timing_, obs, &f.stabilizer);
   f.timings.stabilizer_ms = MsSince(t_stab);
   if (!s.ok()) return s;
+  CropStep(stamp, &f);
   s = options_.warp.mode == WarpMode::kComposite ? CompositeStep(image, stamp, obs, &f)
                                                 : WarpStep(image, stamp, obs, &f);
   if (s.ok() && defer_render_ && options_.warp.mode != WarpMode::kComposite) {
@@ -332,6 +340,30 @@ void Pipeline::RenderDeferred(const cv::Mat& image, PipelineFrame* frame) {
   frame->timings.total_ms += frame->timings.remap_ms;
 }
 
+void Pipeline::CropStep(Time stamp, PipelineFrame* f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  double shake = 0.0, solved = 0.0;
+  if (options_.crop.mode == CropMode::kDynamic) {
+    // Room for the shake (the real camera against its low-passed path), and
+    // for what the solves asked for before the protrusion search held them
+    // in: the subject layer's (in global mode, the face held against the
+    // scene) and the background layer's where it has one.
+    const StabilizerFrame& sf = f->stabilizer;
+    const OutputGeometry& g = warper_->output_geometry();
+    const double dt = has_crop_stamp_ ? ToSeconds(stamp - crop_stamp_) : 0.0;
+    has_crop_stamp_ = true;
+    crop_stamp_ = stamp;
+    shake = CropNeed(model_, g, shake_path_.Update(sf.R_r, dt), Eigen::Vector2d::Zero(), sf.rows);
+    solved = CropNeed(model_, g, sf.R_v_solved, sf.t_solved, sf.rows);
+    if (sf.background.valid) {
+      solved = std::max(solved, CropNeed(model_, g, sf.background.R_v_solved,
+                                         sf.background.t_solved, sf.rows));
+    }
+  }
+  f->crop = crop_->Update(ToSeconds(stamp), shake, solved);
+  f->timings.crop_ms = MsSince(t0);
+}
+
 void Pipeline::ApplyOffsetEstimate(Time stamp) {
   // The correction follows the check's estimate from the next frame on
   // (this frame's rows were covered under the old one), rate-limited; it
@@ -353,6 +385,9 @@ Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
   PipelineFrame f;
   const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
   f.stabilizer.rows = RowRotations(I, model_.intrinsics().height);
+  warper_->SetCropRatio(crop_->crop_ratio());
+  f.crop.crop_ratio = f.crop.target = crop_->crop_ratio();
+  f.crop.dynamic = options_.crop.mode == CropMode::kDynamic;
   f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(Eigen::Vector2d::Zero());
   Status s = warper_->Warp(image, I, Eigen::Vector2d::Zero(), f.stabilizer.rows, &f.output);
   f.timings.mesh_ms = warper_->timings().mesh_ms;
@@ -389,6 +424,7 @@ Status Pipeline::UpdateLayering(WarpMode mode, const LayeredWarpOptions& layered
     if (!s.ok()) return s;
   }
   warper_ = std::move(warper);
+  warper_->SetCropRatio(crop_->crop_ratio());
   compositor_ = std::move(compositor);
   if (compositor_ != nullptr) compositor_->KeepPlateUse(keep_plate_use_);
   options_.warp = w;
@@ -462,6 +498,9 @@ void Pipeline::Reset() {
   // again within seconds.
   timeline_.set_offset_correction(0.0);
   has_check_stamp_ = false;
+  crop_.reset(new DynamicCrop(options_.crop, options_.warp.output.crop_ratio));
+  shake_path_.reset();
+  has_crop_stamp_ = false;
 }
 
 }  // namespace steadiface

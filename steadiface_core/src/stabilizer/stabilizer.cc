@@ -92,6 +92,12 @@ Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
   return Status::Ok();
 }
 
+void Stabilizer::SetCropRatio(double r) {
+  if (r == output_.crop_ratio()) return;
+  output_ = output_.WithCropRatio(r);
+  protrusion_ = ProtrusionGeometry(model_, output_, options_.terms.protrusion_samples_per_edge);
+}
+
 void Stabilizer::reset() {
   subject_ = LayerState();
   reach_limit_ = 0.0;
@@ -372,6 +378,8 @@ void Stabilizer::ProtrusionStep(const LayerState& layer, Eigen::Quaterniond* R_v
   // Protrusion handling (§4.4): binary search towards the real pose, else
   // the previous warp.
   const auto t_prot = Clock::now();
+  f->R_v_solved = *R_v;
+  f->t_solved = *t;
   const ProtrusionReport check = protrusion_.Check(*R_v, *t, f->rows, 0.0);
   if (!check.defined) {
     f->flags.protrusion_search = true;
@@ -443,6 +451,8 @@ void Stabilizer::BackgroundLayer(Time stamp, const OrientationTimeline& timeline
   f->background.valid = true;
   f->background.R_v = R_v;
   f->background.t = t;
+  f->background.R_v_solved = b.R_v_solved;
+  f->background.t_solved = b.t_solved;
   f->background.flags = b.flags;
   f->background.solver = b.solver;
 }

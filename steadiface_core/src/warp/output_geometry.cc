@@ -1,5 +1,6 @@
 #include "steadiface_core/warp/output_geometry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -29,16 +30,21 @@ Status OutputGeometry::Create(const CameraModel& model,
   OutputGeometry g;
   g.width_ = options.width > 0 ? options.width : k.width;
   g.height_ = options.height > 0 ? options.height : k.height;
-  g.crop_ratio_ = options.crop_ratio;
   g.f_v_ = model.virtual_focal();
-  const double extent_y = k.height * (k.fx / k.fy) / k.width;
-  g.margin_ = Eigen::Vector2d(options.crop_ratio, options.crop_ratio * extent_y);
-  g.half_extent_ = 0.5 * (1.0 - 2.0 * options.crop_ratio) *
-                   Eigen::Vector2d(1.0, extent_y);
+  g.extent_y_ = k.height * (k.fx / k.fy) / k.width;
+  *out = g.WithCropRatio(options.crop_ratio);
+  return Status::Ok();
+}
+
+OutputGeometry OutputGeometry::WithCropRatio(double r) const {
+  OutputGeometry g = *this;
+  r = std::isfinite(r) ? std::min(std::max(r, 0.0), 0.4) : crop_ratio_;
+  g.crop_ratio_ = r;
+  g.margin_ = Eigen::Vector2d(r, r * extent_y_);
+  g.half_extent_ = 0.5 * (1.0 - 2.0 * r) * Eigen::Vector2d(1.0, extent_y_);
   g.scale_ = Eigen::Vector2d(2.0 * g.half_extent_.x() / g.width_,
                              2.0 * g.half_extent_.y() / g.height_);
-  *out = g;
-  return Status::Ok();
+  return g;
 }
 
 Eigen::Vector2d OutputGeometry::OutputPixelToVirtual(

@@ -149,6 +149,12 @@ Warper::Warper(const CameraModel& model, const WarpOptions& options,
   if (layered) blend_.reset(new LayerBlend(mesh_.u, mesh_.v, options.layered.blend));
 }
 
+void Warper::SetCropRatio(double r) {
+  if (r == output_.crop_ratio()) return;
+  output_ = output_.WithCropRatio(r);
+  protrusion_ = ProtrusionGeometry(model_, output_, options_.protrusion_samples_per_edge);
+}
+
 Status Warper::MeshForPose(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
                            const RowRotations& rows, std::vector<Eigen::Vector2f>* source,
                            std::vector<float>* source_row) const {

@@ -50,6 +50,12 @@ struct FrameWarp {
   Eigen::Vector2d head_target = Eigen::Vector2d::Zero();
   /// Per-stage time of this frame [ms] (name, value); optional.
   std::vector<std::pair<std::string, double>> stage_ms;
+  /// The crop ratio this frame was made with (the dynamic crop: kPose and
+  /// kComposite map through the output geometry at it); NaN: the
+  /// scorecard's output geometry's.
+  double crop_ratio = NAN;
+  /// The margin the frame's solved pose asked for (CropNeed); optional.
+  double crop_need = NAN;
 };
 
 /// The numbers of one method on one sequence.
@@ -77,8 +83,13 @@ struct Score {
   /// of the frame-to-frame motion over its total energy, excluding DC
   /// (1 = perfectly smooth), for the head and the background.
   double head_stability = 0.0, background_stability = 0.0;
-  /// Output area over input area (1 = no crop).
+  /// Output area over input area (1 = no crop), mean over frames.
   double cropping = 1.0;
+  /// The width the output keeps of the input's, 1 - 2 r [-]: mean and
+  /// least over frames; the largest per-frame change and the RMS of its
+  /// second difference (the zoom's breathing) [-].
+  double kept_width_mean = 1.0, kept_width_min = 1.0;
+  double kept_width_max_step = 0.0, kept_width_rms_accel = 0.0;
   /// Min over frames of the ratio of the smaller to the larger singular
   /// value of the warp's local linear part at the output centre (1 = no
   /// distortion).
@@ -153,6 +164,7 @@ class Scorecard {
     double virtual_angle[3] = {0, 0, 0};  // rotation vector of R_v (rad)
     double real_angle[3] = {0, 0, 0};     // rotation vector of R_r (rad)
     Eigen::Vector2d offset = Eigen::Vector2d::Zero();  // t
+    double crop_ratio = NAN, crop_need = NAN;          // FrameWarp's
   };
   const std::vector<Sample>& samples() const { return samples_; }
 
@@ -176,6 +188,8 @@ class Scorecard {
   // of at least min_run frames) and the lines', cells' and steps' figures.
   void ComputeBackground(double fps, size_t min_run, double diag, Score* sc) const;
   void ComputeMeshFigures(double fps, Score* sc) const;
+  // The crop kept: mean and least width, its steps and second difference.
+  void ComputeCrop(bool pose, Score* sc) const;
   bool MapToOutput(const FrameWarp& w, const Eigen::Vector2d& in_px,
                    Eigen::Vector2d* out_px) const;
   // kComposite: whether the subject, placed by the subject layer, covers
@@ -185,8 +199,11 @@ class Scorecard {
   const sim::Simulator& sim_;
   const CameraModel model_;
   const OutputGeometry output_;
-  const ProtrusionGeometry protrusion_;
   const ScorecardOptions options_;
+  // The frame being added: the output geometry at its crop, its boundary.
+  OutputGeometry frame_output_;
+  ProtrusionGeometry frame_protrusion_;
+  std::vector<double> kept_width_;  // per frame, 1 - 2 r
   std::vector<Eigen::Vector3d> background_dirs_;
   std::vector<Eigen::Vector3d> visible_dirs_;
   std::vector<std::vector<Eigen::Vector2d>> visible_out_;  // [point][frame]

@@ -14,6 +14,8 @@
 #include "steadiface_core/face/face_tracker.h"
 #include "steadiface_core/gyro/orientation_timeline.h"
 #include "steadiface_core/stabilizer/stabilizer.h"
+#include "steadiface_core/view/dynamic_crop.h"
+#include "steadiface_core/view/shake_path.h"
 #include "steadiface_core/visual/visual_rotation.h"
 #include "steadiface_core/warp/warper.h"
 
@@ -56,6 +58,9 @@ struct PipelineOptions {
   FaceTrackerOptions face;
   StabilizerOptions stabilizer;
   WarpOptions warp;
+  /// The output's crop: warp.output.crop_ratio on every frame (kFixed), or
+  /// a dynamic crop between crop.widest_crop_ratio and it.
+  DynamicCropOptions crop;
   /// The composite (warp mode composite): matte, plate, blend.
   CompositeOptions composite;
   /// Produce the stabilized image (false: poses only, e.g. for scoring).
@@ -81,6 +86,8 @@ struct PipelineTimings {
   double remap_ms = 0.0;
   /// Composite mode: the matte, the plate and the blend.
   double composite_ms = 0.0;
+  /// The dynamic crop: the need of the solved pose(s) and the crop's update.
+  double crop_ms = 0.0;
   double total_ms = 0.0;
 };
 
@@ -109,8 +116,12 @@ struct PipelineFrame {
   /// Stabilized, cropped, scaled output (empty when render_output is off or
   /// the warp refused the pose).
   cv::Mat output;
-  /// Intrinsics of `output` (virtual focal and principal offset).
+  /// Intrinsics of `output` (virtual focal and principal offset; with the
+  /// dynamic crop, the frame's zoom).
   CameraIntrinsics output_intrinsics;
+  /// The crop the frame was made with, and the dynamic crop's need and
+  /// target.
+  CropReport crop;
   PipelineTimings timings;
   /// The gyro-vs-video check over its window (GyroVideoCheck).
   GyroVideoCheckResult gyro_video_check;
@@ -227,6 +238,9 @@ class Pipeline {
   Status VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f);
   Pipeline(const CameraModel& model, const PipelineOptions& options);
   void ApplyOffsetEstimate(Time stamp);
+  // The dynamic crop: the margin this frame's solved pose(s) asked for
+  // moves the next frame's crop (kFixed: the report only).
+  void CropStep(Time stamp, PipelineFrame* f);
 
   const CameraModel model_;
   PipelineOptions options_;
@@ -243,6 +257,10 @@ class Pipeline {
   bool imu_missing_ = false;  // kAuto: SetImuMissing
   std::unique_ptr<SubjectRegionTracker> region_;  // layered and composite mode
   std::unique_ptr<Compositor> compositor_;       // composite mode
+  std::unique_ptr<DynamicCrop> crop_;
+  ShakePath shake_path_;  // the dynamic crop's room for the shake
+  bool has_crop_stamp_ = false;
+  Time crop_stamp_;
   cv::Mat subject_picture_;                      // composite: the subject layer's
   bool keep_plate_use_ = false;
   bool has_last_stamp_ = false;

@@ -78,6 +78,11 @@ struct StabilizerFrame {
   /// Virtual rotation R_v (world -> virtual camera) and principal offset t.
   Eigen::Quaterniond R_v = Eigen::Quaterniond::Identity();
   Eigen::Vector2d t = Eigen::Vector2d::Zero();
+  /// The solve's pose before the protrusion search moved it towards the
+  /// real one (R_v, t when the search did not run): the margin the motion
+  /// asked for, which the dynamic crop follows.
+  Eigen::Quaterniond R_v_solved = Eigen::Quaterniond::Identity();
+  Eigen::Vector2d t_solved = Eigen::Vector2d::Zero();
   /// Real rotation at the middle row, and per row.
   Eigen::Quaterniond R_r = Eigen::Quaterniond::Identity();
   RowRotations rows;
@@ -103,6 +108,9 @@ struct StabilizerFrame {
     bool valid = false;  ///< solved this frame (background_layer on)
     Eigen::Quaterniond R_v = Eigen::Quaterniond::Identity();
     Eigen::Vector2d t = Eigen::Vector2d::Zero();
+    /// Before the protrusion search (as StabilizerFrame::R_v_solved).
+    Eigen::Quaterniond R_v_solved = Eigen::Quaterniond::Identity();
+    Eigen::Vector2d t_solved = Eigen::Vector2d::Zero();
     StabilizerFlags flags;
     SolverReport solver;
   };
@@ -158,6 +166,11 @@ class Stabilizer {
   /// within min(subject_reach, this) of where the background layer shows the
   /// face. <= 0: subject_reach alone.
   void SetReachLimit(double jaw_widths) { reach_limit_ = jaw_widths; }
+
+  /// The dynamic crop: the window E_p, the protrusion search and Eq. 1's
+  /// margin keep inside the real frame, from the next Process() on, is
+  /// (1 - 2 r) of the frame (OutputGeometry::WithCropRatio).
+  void SetCropRatio(double r);
 
   /// Forgets the trajectory (time jumped, new epoch). Counters are kept.
   void reset();
@@ -258,8 +271,9 @@ class Stabilizer {
   void AdvanceStep(Time stamp, LayerState* layer, const StabilizerFrame& f) const;
 
   const CameraModel model_;
-  const OutputGeometry output_;
-  const ProtrusionGeometry protrusion_;
+  // The crop in effect (SetCropRatio) and its protrusion boundary.
+  OutputGeometry output_;
+  ProtrusionGeometry protrusion_;
   StabilizerOptions options_;
   HeadSmoother smoother_;
   DynamicWeights dynamic_;

@@ -45,6 +45,10 @@ class OutputGeometry {
   int width() const { return width_; }
   int height() const { return height_; }
   double crop_ratio() const { return crop_ratio_; }
+  /// The same output (size, virtual focal length) with another crop ratio
+  /// r in [0, 0.4] (the dynamic crop): the window, scaled about its centre,
+  /// spans (1 - 2 r) of the frame. Out-of-range r is clamped.
+  OutputGeometry WithCropRatio(double r) const;
   /// Crop margin per side in normalized units, x and y (the head smoother's
   /// r and the protrusion reference).
   Eigen::Vector2d margin() const { return margin_; }
@@ -64,6 +68,7 @@ class OutputGeometry {
   int width_ = 0, height_ = 0;
   double crop_ratio_ = 0.0;
   double f_v_ = 1.0;
+  double extent_y_ = 1.0;  // the frame's normalized height, H (fx/fy) / W
   Eigen::Vector2d margin_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d half_extent_ = Eigen::Vector2d::Zero();
   // normalized units per output pixel, x and y

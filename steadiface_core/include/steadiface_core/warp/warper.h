@@ -137,6 +137,9 @@ class Warper {
                             const Eigen::Quaterniond& R_b, const Eigen::Vector2d& t_b,
                             const RowRotations& rows, const SubjectRegion& region,
                             double dt);
+  /// The dynamic crop: output pixels tile (1 - 2 r) of the frame from the
+  /// next mesh on (OutputGeometry::WithCropRatio); the output size stays.
+  void SetCropRatio(double r);
   /// Forgets the layered mesh's temporal state (time jumped).
   void reset() {
     if (blend_ != nullptr) blend_->reset();
@@ -175,8 +178,9 @@ class Warper {
 
   const CameraModel model_;
   const WarpOptions options_;
-  const OutputGeometry output_;
-  const ProtrusionGeometry protrusion_;
+  // The crop in effect (SetCropRatio) and its protrusion boundary.
+  OutputGeometry output_;
+  ProtrusionGeometry protrusion_;
   // Fills `source`/`source_row` with one pose's mesh.
   Status MeshForPose(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
                      const RowRotations& rows, std::vector<Eigen::Vector2f>* source,
