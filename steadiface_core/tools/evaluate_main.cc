@@ -167,6 +167,8 @@ int Usage() {
                "         shows a 30 px face)\n"
                "       [--crop-mode fixed|dynamic] (output.crop: the fixed crop ratio, or the\n"
                "         dynamic crop between --widest R and it; default: the package's)\n"
+               "       [--horizon off|level|lock] (output.horizon: the roll against the\n"
+               "         accelerometer's gravity)\n"
                "       [--rotation-source imu|visual] (visual: the camera's rotation from\n"
                "         the video, the IMU unused)\n"
                "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
@@ -276,6 +278,9 @@ int main(int argc, char** argv) {
   double head_distance = NAN;    // the subject's distance [m]; NaN: the preset's
   bool visual_rotation = false;  // --rotation-source visual
   int crop_mode = -1;            // --crop-mode: 0 fixed, 1 dynamic; -1: the default
+  std::string horizon;           // --horizon: off, level or lock; empty: the default
+  // horizon.level_weight, lock_weight, warmup, time_constant (NaN: default)
+  double level_weight = NAN, lock_weight = NAN, gravity_warmup = NAN, gravity_tau = NAN;
   double widest = NAN;           // --widest: output.dynamic.widest_crop_ratio
   bool start_tight = false;      // --start-tight: output.dynamic.start_wide false
   double shake_hz = NAN, headroom = NAN;  // output.dynamic.shake_path_hz, headroom
@@ -310,6 +315,13 @@ int main(int argc, char** argv) {
     crop_mode = v == "dynamic" ? 1 : 0;
     return v == "fixed" || v == "dynamic";
   });
+  cl.Value("--horizon", "off, level or lock", [&](const std::string& v) {
+    horizon = v;
+    steadiface::HorizonMode m;
+    return steadiface::ParseHorizonMode(v, &m).ok();
+  });
+  cl.Double("--level-weight", &level_weight).Double("--lock-weight", &lock_weight);
+  cl.Double("--gravity-warmup", &gravity_warmup).Double("--gravity-tau", &gravity_tau);
   cl.Double("--widest", &widest).Flag("--start-tight", &start_tight);
   cl.Double("--shake-hz", &shake_hz).Double("--headroom", &headroom);
   cl.Double("--widen-rate", &widen_rate).Double("--tighten-rate", &tighten_rate);
@@ -500,6 +512,11 @@ int main(int argc, char** argv) {
           po.crop.mode = crop_mode == 1 ? steadiface::CropMode::kDynamic : steadiface::CropMode::kFixed;
         }
         if (std::isfinite(widest)) po.crop.widest_crop_ratio = widest;
+        if (!horizon.empty()) steadiface::ParseHorizonMode(horizon, &po.horizon.mode);
+        if (std::isfinite(level_weight)) po.horizon.level_weight = level_weight;
+        if (std::isfinite(lock_weight)) po.horizon.lock_weight = lock_weight;
+        if (std::isfinite(gravity_warmup)) po.horizon.warmup_s = gravity_warmup;
+        if (std::isfinite(gravity_tau)) po.horizon.time_constant_s = gravity_tau;
         if (start_tight) po.crop.start_wide = false;
         if (std::isfinite(shake_hz)) po.crop.shake_path_hz = shake_hz;
         if (std::isfinite(headroom)) po.crop.headroom = headroom;
@@ -638,6 +655,8 @@ int main(int argc, char** argv) {
            << ", \"kept_width_min\": " << jnum(sc.kept_width_min)
            << ", \"kept_width_max_step\": " << jnum(sc.kept_width_max_step)
            << ", \"kept_width_rms_accel\": " << jnum(sc.kept_width_rms_accel)
+           << ", \"output_roll_rms_deg\": " << jnum(sc.output_roll_rms_deg)
+           << ", \"input_roll_rms_deg\": " << jnum(sc.input_roll_rms_deg)
            << ", \"undefined_fraction\": " << jnum(sc.undefined_fraction)
            << ", \"face_fraction\": " << jnum(face_fraction)
            << ", \"visible_background_jitter_px\": " << jnum(sc.visible_background_jitter_px)

@@ -72,6 +72,16 @@ steadiface::GyroSample ToGyroSample(const sensor_msgs::Imu& imu) {
   return s;
 }
 
+bool ToAccelSample(const sensor_msgs::Imu& imu, steadiface::AccelSample* out) {
+  const auto& a = imu.linear_acceleration;
+  if (imu.linear_acceleration_covariance[0] == -1.0 || (a.x == 0.0 && a.y == 0.0 && a.z == 0.0)) {
+    return false;
+  }
+  out->stamp = ToCoreTime(imu.header.stamp);
+  out->linear_acceleration = Eigen::Vector3d(a.x, a.y, a.z);
+  return true;
+}
+
 bool ToEigen(const geometry_msgs::Quaternion& msg, Eigen::Quaterniond* q) {
   Eigen::Quaterniond e(msg.w, msg.x, msg.y, msg.z);
   const double n = e.norm();

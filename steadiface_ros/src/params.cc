@@ -413,6 +413,19 @@ void ReadCrop(Reader& r, steadiface::DynamicCropOptions* c) {
   r.Bool("output/dynamic/start_wide", &c->start_wide);
 }
 
+void ReadHorizon(Reader& r, steadiface::HorizonOptions* h) {
+  std::string mode = steadiface::HorizonModeName(h->mode);
+  r.Choice("output/horizon", &mode);
+  const Status ms = steadiface::ParseHorizonMode(mode, &h->mode);
+  if (!ms.ok()) r.Error("parameter 'output/horizon': " + ms.message());
+  r.Num("horizon/gravity_tolerance", &h->gravity_tolerance);
+  r.Num("horizon/time_constant", &h->time_constant_s);
+  r.Num("horizon/lowpass", &h->lowpass_hz);
+  r.Num("horizon/warmup", &h->warmup_s);
+  r.Num("horizon/level_weight", &h->level_weight);
+  r.Num("horizon/lock_weight", &h->lock_weight);
+}
+
 void ReadLayered(Reader& r, steadiface::LayeredWarpOptions* lw) {
   r.Int("warp/layered/mesh_cols", &lw->mesh_cols);
   r.Int("warp/layered/mesh_rows", &lw->mesh_rows);
@@ -492,6 +505,7 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   ReadSolverAndStabilizer(r, &po->stabilizer);
   ReadOutputAndWarp(r, &po->warp);
   ReadCrop(r, &po->crop);
+  ReadHorizon(r, &po->horizon);
   ReadLayered(r, &po->warp.layered);
   ReadComposite(r, &po->composite);
   ReadGyroVideoCheck(r, &po->gyro_video_check);

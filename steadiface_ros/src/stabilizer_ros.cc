@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
+#include <sstream>
 
 #include "image_decoder.h"
 #include "steadiface_ros/msg_conversion.h"
@@ -112,6 +114,7 @@ void StabilizerRos::StartDiagnostics() {
   updater_->add(*imu_freq_);
   updater_->add("gyro", this, &StabilizerRos::DiagGyro);
   updater_->add("rotation source", this, &StabilizerRos::DiagRotationSource);
+  updater_->add("view", this, &StabilizerRos::DiagView);
   updater_->add("face", this, &StabilizerRos::DiagFace);
   updater_->add("solver", this, &StabilizerRos::DiagSolver);
   updater_->add("frames", this, &StabilizerRos::DiagFrames);
@@ -344,6 +347,38 @@ void StabilizerRos::DiagRotationSource(diagnostic_updater::DiagnosticStatusWrapp
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
               what + ": too few features fit one rotation (texture, darkness, a crowd); "
                      "holding the camera still");
+  }
+}
+
+void StabilizerRos::DiagView(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  // The crop and the level horizon as of the last frame.
+  const WrapperStatus w = wrapper_->Status();
+  const double deg = 180.0 / M_PI;
+  s.add("crop", w.crop.dynamic ? "dynamic" : "fixed");
+  s.add("kept width", 1.0 - 2.0 * w.crop.crop_ratio);
+  s.add("crop target", w.crop.target);
+  s.add("horizon", w.horizon_mode);
+  s.add("accelerometer readings taken", w.accel_accepted);
+  s.add("accelerometer readings left out", w.accel_rejected);
+  s.add("output roll [deg]", w.horizon.output_roll_rad * deg);
+  s.add("camera roll [deg]", w.horizon.real_roll_rad * deg);
+  std::ostringstream what;
+  what << "kept width " << std::fixed << std::setprecision(2) << 1.0 - 2.0 * w.crop.crop_ratio
+       << (w.crop.dynamic ? " (dynamic)" : "") << "; horizon " << w.horizon_mode;
+  if (w.horizon_mode == "off" || !w.pipeline_ready) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, what.str());
+  } else if (w.horizon.active) {
+    what << ", output roll " << std::setprecision(1) << w.horizon.output_roll_rad * deg
+         << " deg (camera " << w.horizon.real_roll_rad * deg << " deg)";
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK, what.str());
+  } else {
+    what << " inactive: "
+         << (w.horizon.inactive_reason == "visual rotation"
+                 ? "the rotation comes from the video; the roll is kept as without a horizon"
+                 : w.accel_accepted + w.accel_rejected == 0
+                       ? "no accelerometer readings in the IMU messages"
+                       : "gravity not known yet (readings far from 1 g are left out)");
+    s.summary(diagnostic_msgs::DiagnosticStatus::WARN, what.str());
   }
 }
 

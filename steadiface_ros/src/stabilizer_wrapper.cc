@@ -149,6 +149,13 @@ void StabilizerWrapper::OnImu(const sensor_msgs::Imu& msg) {
                 std::string("IMU sample rejected: ") + steadiface::SampleResultName(r));
     return;
   }
+  // Gravity for the level horizon, from the same message (the pipeline
+  // counts what it leaves out).
+  steadiface::AccelSample a;
+  if (ToAccelSample(msg, &a)) {
+    ++counters_.accel_in;
+    if (pipeline_) pipeline_->AddAccel(a);
+  }
   // The scheduler keeps a bounded copy for rebuilding the pipeline.
   scheduler_.OnGyroAccepted(g, steadiface::FromSeconds(options_.imu.buffer_duration_s),
                             static_cast<size_t>(options_.imu.max_samples));
@@ -561,6 +568,8 @@ void StabilizerWrapper::UpdateStatus(const steadiface::PipelineFrame& frame,
     ++counters_.from_video;
   }
   status_.imu_offset_applied_s = frame.imu_offset_applied_s;
+  status_.horizon = frame.horizon;
+  status_.crop = frame.crop;
   status_.face_state = frame.face.state;
   status_.face_failure = steadiface::FaceFailureName(frame.face.failure);
   status_.face_confidence = frame.face.confidence;
@@ -585,7 +594,10 @@ WrapperStatus StabilizerWrapper::Status() const {
   if (pipeline_) {
     s.timeline = pipeline_->timeline().stats();
     s.stabilizer = pipeline_->stabilizer().stats();
+    s.accel_accepted = pipeline_->gravity().accepted();
+    s.accel_rejected = pipeline_->gravity().rejected();
   }
+  s.horizon_mode = steadiface::HorizonModeName(options_.horizon.mode);
   return s;
 }
 

@@ -124,3 +124,27 @@ TEST(MsgConversionTest, QuaternionRoundTripAndRejection) {
 
 }  // namespace
 }  // namespace steadiface_ros
+
+namespace steadiface_ros {
+namespace {
+
+TEST(MsgConversionTest, ImuToAccelSample) {
+  sensor_msgs::Imu imu;
+  imu.header.stamp = ros::Time(12, 500000000);
+  imu.linear_acceleration.x = 0.1;
+  imu.linear_acceleration.y = -9.8;
+  imu.linear_acceleration.z = 0.3;
+  steadiface::AccelSample a;
+  ASSERT_TRUE(ToAccelSample(imu, &a));
+  EXPECT_DOUBLE_EQ(steadiface::ToSeconds(a.stamp), 12.5);
+  EXPECT_EQ(a.linear_acceleration, Eigen::Vector3d(0.1, -9.8, 0.3));
+  // "Not provided", by the message's convention or by zeros.
+  imu.linear_acceleration_covariance[0] = -1.0;
+  EXPECT_FALSE(ToAccelSample(imu, &a));
+  imu.linear_acceleration_covariance[0] = 0.0;
+  imu.linear_acceleration.x = imu.linear_acceleration.y = imu.linear_acceleration.z = 0.0;
+  EXPECT_FALSE(ToAccelSample(imu, &a));
+}
+
+}  // namespace
+}  // namespace steadiface_ros

@@ -62,6 +62,12 @@ FrameWarp MakeFrameWarp(const PipelineFrame& out, const Pipeline& p, bool render
   w.crop_need = std::max(out.crop.shake_need, out.crop.solved_need);
   w.head_target = out.stabilizer.H;
   const bool layered = p.options().warp.mode == WarpMode::kLayered;
+  if (layered || p.options().warp.mode == WarpMode::kComposite) {
+    // The scene's layer (for the horizon's roll; kComposite's far scene).
+    const StabilizerFrame::LayerPose& b = out.stabilizer.background;
+    w.R_b = b.valid ? b.R_v : out.stabilizer.R_v;
+    w.t_b = b.valid ? b.t : out.stabilizer.t;
+  }
   if (p.options().warp.mode == WarpMode::kComposite) {
     const StabilizerFrame::LayerPose& b = out.stabilizer.background;
     w.kind = FrameWarp::Kind::kComposite;
@@ -94,11 +100,14 @@ FrameWarp MakeFrameWarp(const PipelineFrame& out, const Pipeline& p, bool render
 void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_offset_s,
                       Pipeline* pipeline, size_t* next) {
   const auto& imu = sim.imu();
+  const auto& accel = sim.accel();
   const Time need = pipeline->LastRowTime(stamp);
   while (*next < imu.size() &&
          (!pipeline->GyroCovers(stamp) ||
           imu[*next].stamp + FromSeconds(imu_time_offset_s) <= need)) {
-    pipeline->AddGyro(imu[(*next)++]);
+    pipeline->AddGyro(imu[*next]);
+    if (*next < accel.size()) pipeline->AddAccel(accel[*next]);  // one IMU message
+    ++*next;
   }
 }
 

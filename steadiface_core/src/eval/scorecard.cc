@@ -261,6 +261,7 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     if (k == 13) s.background_out = o;  // centre of the middle view
   }
   if (w.kind != FrameWarp::Kind::kIdentity) identity_ = false;
+  AddRoll(truth, w);
   head_target_out_.push_back(w.has_head_target ? frame_output_.VirtualToOutputPixel(w.head_target)
                                                : Eigen::Vector2d::Constant(NAN));
   AddVisibleBackground(index, w);
@@ -269,6 +270,24 @@ void Scorecard::Add(int index, const FrameWarp& w) {
   undefined_ += Undefined(w, &s);
   AddStageTimes(w);
   samples_.push_back(s);
+}
+
+void Scorecard::AddRoll(const sim::SimTruth& truth, const FrameWarp& w) {
+  // The true up in the camera at the middle row; the output's camera is the
+  // real one turned by R_out R_r^-1 (R_r the pipeline's middle row).
+  if (truth.R_r.empty()) return;
+  const Eigen::Quaterniond& R_true = truth.R_r[truth.R_r.size() / 2];  // world -> camera
+  const Eigen::Vector3d up_cam = R_true * Eigen::Vector3d(0.0, -1.0, 0.0);
+  input_roll_.push_back(std::atan2(up_cam.x(), -up_cam.y()));
+  if (w.kind != FrameWarp::Kind::kPose && w.kind != FrameWarp::Kind::kComposite &&
+      w.kind != FrameWarp::Kind::kMesh) {
+    if (w.kind == FrameWarp::Kind::kIdentity) output_roll_.push_back(input_roll_.back());
+    return;
+  }
+  if (w.rows.empty()) return;
+  const Eigen::Quaterniond& R_out = w.kind == FrameWarp::Kind::kPose ? w.R_v : w.R_b;
+  const Eigen::Vector3d up_out = R_out * (w.rows.Middle().conjugate() * up_cam);
+  output_roll_.push_back(std::atan2(up_out.x(), -up_out.y()));
 }
 
 void Scorecard::AddVisibleBackground(int index, const FrameWarp& w) {
@@ -446,6 +465,13 @@ Score Scorecard::Compute() const {
   ComputeBackground(fps, min_run, diag, &sc);
   ComputeMeshFigures(fps, &sc);
   ComputeCrop(pose, &sc);
+  auto rms_deg = [](const std::vector<double>& x) {
+    double s2 = 0.0;
+    for (double v : x) s2 += v * v;
+    return x.empty() ? NAN : std::sqrt(s2 / x.size()) * 180.0 / M_PI;
+  };
+  if (output_roll_.size() == samples_.size()) sc.output_roll_rms_deg = rms_deg(output_roll_);
+  sc.input_roll_rms_deg = rms_deg(input_roll_);
   sc.distortion = *std::min_element(distortion_.begin(), distortion_.end());
   sc.undefined_fraction = static_cast<double>(undefined_) / sc.frames;
   for (const auto& st : stages_) {

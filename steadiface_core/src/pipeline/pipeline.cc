@@ -53,6 +53,8 @@ Status ValidatePipelineOptions(const PipelineOptions& o) {
   }
   s = ValidateWarpOptions(o.warp);
   if (!s.ok()) return s;
+  s = ValidateHorizonOptions(o.horizon);
+  if (!s.ok()) return s;
   return ValidateDynamicCropOptions(o.crop);
 }
 
@@ -63,7 +65,8 @@ Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
       timeline_(TimelineOptions(options)),
       region_(new SubjectRegionTracker(options.warp.layered.region)),
       crop_(new DynamicCrop(options.crop, options.warp.output.crop_ratio)),
-      shake_path_(options.crop.shake_path_hz) {}
+      shake_path_(options.crop.shake_path_hz),
+      gravity_(options.horizon) {}
 
 StabilizerOptions ForWarp(const StabilizerOptions& options, const WarpOptions& warp) {
   StabilizerOptions o = options;
@@ -129,6 +132,13 @@ SampleResult Pipeline::AddGyro(const GyroSample& sample) {
   return timeline_.AddSample(sample);
 }
 
+bool Pipeline::AddAccel(const AccelSample& sample) {
+  // kVisual: the world frame is the video's; the horizon is off then.
+  if (options_.rotation_source == RotationSource::kVisual) return false;
+  const Eigen::Vector3d a_cam = options_.imu.R_cam_imu.normalized() * sample.linear_acceleration;
+  return gravity_.Add(sample.stamp + FromSeconds(options_.imu.imu_time_offset_s), a_cam, timeline_);
+}
+
 bool Pipeline::GyroCovers(Time stamp) const {
   if (options_.rotation_source == RotationSource::kVisual) return true;
   return timeline_.Covers(timing_.FirstRowTime(stamp)) &&
@@ -180,9 +190,11 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   const auto t_stab = std::chrono::steady_clock::now();
   stabilizer_->SetCropRatio(crop_->crop_ratio());
   warper_->SetCropRatio(crop_->crop_ratio());
+  HorizonStep(&f);
   Status s = stabilizer_->Process(stamp, timeline_, timing_, obs, &f.stabilizer);
   f.timings.stabilizer_ms = MsSince(t_stab);
   if (!s.ok()) return s;
+  HorizonReportStep(&f);
   CropStep(stamp, &f);
   s = options_.warp.mode == WarpMode::kComposite ? CompositeStep(image, stamp, obs, &f)
                                                 : WarpStep(image, stamp, obs, &f);
@@ -338,6 +350,36 @@ void Pipeline::RenderDeferred(const cv::Mat& image, PipelineFrame* frame) {
   // The frame's work: processing plus this render (which ran beside the
   // next frame's processing, so this is not the frame's latency).
   frame->timings.total_ms += frame->timings.remap_ms;
+}
+
+void Pipeline::HorizonStep(PipelineFrame* f) {
+  const HorizonOptions& o = options_.horizon;
+  PipelineFrame::Horizon& h = f->horizon;
+  h.mode = o.mode;
+  HorizonTarget target;
+  if (o.mode != HorizonMode::kOff) {
+    if (f->rotation_from_video) {
+      h.inactive_reason = "visual rotation";
+    } else if (!gravity_.valid()) {
+      h.inactive_reason = "no accelerometer";
+    } else {
+      target.active = true;
+      target.up_world = gravity_.up_world();
+      target.weight = o.mode == HorizonMode::kLock ? o.lock_weight : o.level_weight;
+      target.level_reference = o.mode == HorizonMode::kLock;
+    }
+  }
+  h.active = target.active;
+  stabilizer_->SetHorizon(target);
+}
+
+void Pipeline::HorizonReportStep(PipelineFrame* f) const {
+  if (!gravity_.valid() || f->rotation_from_video) return;
+  const StabilizerFrame& sf = f->stabilizer;
+  const bool background = sf.background.valid && options_.warp.mode != WarpMode::kGlobal;
+  const Eigen::Quaterniond& R_out = background ? sf.background.R_v : sf.R_v;
+  f->horizon.output_roll_rad = HorizonRoll(R_out * gravity_.up_world());
+  f->horizon.real_roll_rad = HorizonRoll(sf.R_r * gravity_.up_world());
 }
 
 void Pipeline::CropStep(Time stamp, PipelineFrame* f) {
@@ -501,6 +543,7 @@ void Pipeline::Reset() {
   crop_.reset(new DynamicCrop(options_.crop, options_.warp.output.crop_ratio));
   shake_path_.reset();
   has_crop_stamp_ = false;
+  gravity_.reset();
 }
 
 }  // namespace steadiface

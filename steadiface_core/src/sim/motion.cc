@@ -62,7 +62,9 @@ double CameraMotion::PanAngle(double t) const {
 }
 
 Eigen::Quaterniond CameraMotion::Orientation(double t) const {
-  return ExpSO3(Eigen::Vector3d(0.0, PanAngle(t), 0.0)) * ExpSO3(shake_.Value(t));
+  const double roll = options_.roll_amplitude_rad * std::sin(2.0 * M_PI * options_.roll_hz * t);
+  return ExpSO3(Eigen::Vector3d(0.0, PanAngle(t), 0.0)) * ExpSO3(Eigen::Vector3d(0.0, 0.0, roll)) *
+         ExpSO3(shake_.Value(t));
 }
 
 Eigen::Vector3d CameraMotion::Position(double t) const {

@@ -17,7 +17,7 @@ namespace sim {
 const std::vector<std::string>& PresetNames() {
   static const std::vector<std::string> names = {
       "still", "walk", "pan", "run", "occlusion", "two_faces", "turn_away", "vlog", "shake",
-      "drift", "walk_across", "bob", "hair", "passer_by", "robot"};
+      "drift", "walk_across", "bob", "hair", "passer_by", "robot", "roll"};
   return names;
 }
 
@@ -75,6 +75,11 @@ bool ApplyCameraPreset(const std::string& name, SimulatorOptions* o) {
     o->grayscale = true;
     o->exposure_s = 0.025;
     o->readout_s = 0.03;
+  } else if (name == "roll") {
+    // A walking selfie whose horizon tilts by +-10 deg at 0.2 Hz.
+    Walking(o);
+    o->camera.roll_amplitude_rad = 10.0 * M_PI / 180.0;
+    o->camera.roll_hz = 0.2;
   } else if (name == "robot") {
     // A legged robot's head camera (its own sensor: 640x480, 60 deg
     // horizontal field, whatever the size asked for) vibrating with the gait
@@ -294,6 +299,9 @@ void Simulator::SynthesizeImu() {
   const SimulatorOptions& o = options_;
   std::mt19937_64 rng(options_.seed * 104729 + 3);
   std::normal_distribution<double> n01(0.0, 1.0);
+  // The accelerometer's noise from its own stream: the gyro's stays what it
+  // was before there was an accelerometer.
+  std::mt19937_64 rng_accel(options_.seed * 7919 + 11);
   const double t_end = o.duration_s + o.readout_s + 0.06;
   const int n = static_cast<int>(t_end * o.imu_rate_hz) + 1;
   imu_.reserve(n);
@@ -312,7 +320,22 @@ void Simulator::SynthesizeImu() {
     const double clamp = 0.4 / o.imu_rate_hz;  // keep stamps ordered
     const double stamp = t + std::max(-clamp, std::min(clamp, jitter)) - o.imu_clock_offset_s;
     imu_.push_back({Time(FromSeconds(stamp)), w});
+    // The specific force in the camera: R^T (acceleration - gravity), the
+    // acceleration by central differences of the true position.
+    const double h = 1e-3;
+    const Pose P = CameraPose(t);
+    const Eigen::Vector3d acc =
+        (CameraPose(t + h).p - 2.0 * P.p + CameraPose(t - h).p) / (h * h);
+    const Eigen::Vector3d gravity(0.0, kStandardGravity, 0.0);
+    const Eigen::Vector3d f = P.R.conjugate() * (acc - gravity) +
+                              o.accel_noise * Eigen::Vector3d(n01(rng_accel), n01(rng_accel),
+                                                              n01(rng_accel));
+    accel_.push_back({Time(FromSeconds(stamp)), f});
   }
+}
+
+Eigen::Vector3d Simulator::UpInCamera(double t) const {
+  return CameraPose(t).R.conjugate() * Eigen::Vector3d(0.0, -1.0, 0.0);
 }
 
 Eigen::Vector3d Simulator::Body(double t) const {

@@ -18,7 +18,8 @@ struct Stabilizer::PoseProblem {
   double q_block[4];
   double t_block[2];
   ceres::Problem problem;
-  std::vector<ceres::ResidualBlockId> b_fit, b_dist, b_follow, b_rot, b_trans, b_prot;
+  std::vector<ceres::ResidualBlockId> b_fit, b_dist, b_follow, b_rot, b_trans, b_prot,
+      b_horizon;
   Eigen::Map<Eigen::Vector4d> q() { return Eigen::Map<Eigen::Vector4d>(q_block); }
   Eigen::Map<Eigen::Vector2d> t() { return Eigen::Map<Eigen::Vector2d>(t_block); }
 };

@@ -11,6 +11,7 @@
 #include "steadiface_core/stabilizer/distortion_cost.h"
 #include "steadiface_core/stabilizer/fitting_cost.h"
 #include "steadiface_core/stabilizer/following_cost.h"
+#include "steadiface_core/stabilizer/horizon_cost.h"
 #include "steadiface_core/stabilizer/protrusion_cost.h"
 #include "steadiface_core/stabilizer/rotation_smoothness_cost.h"
 #include "steadiface_core/stabilizer/stabilizer.h"
@@ -84,19 +85,25 @@ void Stabilizer::AddRotationTerms(Time stamp, const OrientationTimeline& timelin
                                   const RowTiming& timing, const LayerState& layer,
                                   const StabilizerWeights& w, double dt,
                                   const StabilizerFrame& frame, PoseProblem* pp) const {
-  // E_d (Eq. 7), E_o (Eq. 8) and E_r (Eq. 9).
+  // E_d (Eq. 7), E_o (Eq. 8) and E_r (Eq. 9); E_h (the level horizon).
   const StabilizerFrame* f = &frame;
   ceres::Problem& problem = pp->problem;
+  const Eigen::Quaterniond R_ref = HorizonReference(f->R_r);
+  if (horizon_.active && horizon_.weight > 0.0) {
+    pp->b_horizon.push_back(problem.AddResidualBlock(
+        HorizonCost::Create(horizon_.up_world, std::sqrt(horizon_.weight)), nullptr,
+        pp->q_block));
+  }
   if (w.distortion > 0.0) {
     pp->b_dist.push_back(problem.AddResidualBlock(
-        DistortionCost::Create(f->R_r, options_.terms.distortion_threshold_rad,
+        DistortionCost::Create(R_ref, options_.terms.distortion_threshold_rad,
                                options_.terms.distortion_slope,
                                std::sqrt(w.distortion)),
         nullptr, pp->q_block));
   }
   if (w.follow > 0.0) {
     pp->b_follow.push_back(problem.AddResidualBlock(
-        FollowingCost::Create(f->R_r, std::sqrt(w.follow)), nullptr, pp->q_block));
+        FollowingCost::Create(R_ref, std::sqrt(w.follow)), nullptr, pp->q_block));
   }
   if (layer.history >= 1) {
     const Eigen::Quaterniond prev_delta =
@@ -206,6 +213,17 @@ void Stabilizer::EnergiesStep(const Eigen::Quaterniond& R_v, const Eigen::Vector
   f->energies.rotation = TermEnergy(&pp->problem, pp->b_rot);
   f->energies.translation = TermEnergy(&pp->problem, pp->b_trans);
   f->energies.protrusion = TermEnergy(&pp->problem, pp->b_prot);
+  f->energies.horizon = TermEnergy(&pp->problem, pp->b_horizon);
+}
+
+Eigen::Quaterniond Stabilizer::HorizonReference(const Eigen::Quaterniond& R_r) const {
+  // lock: the real camera turned about its optical axis until gravity's up
+  // is the image's up (HorizonRoll 0), for E_d and E_o to measure against.
+  if (!horizon_.active || !horizon_.level_reference) return R_r;
+  const Eigen::Vector3d u = R_r * horizon_.up_world;
+  if (u.head<2>().norm() < 1e-3) return R_r;
+  const double roll = std::atan2(u.x(), -u.y());
+  return AlignSign((Eigen::AngleAxisd(-roll, Eigen::Vector3d::UnitZ()) * R_r).normalized(), R_r);
 }
 
 }  // namespace steadiface

@@ -30,6 +30,10 @@ steadiface::Status ToCameraIntrinsics(const sensor_msgs::CameraInfo& info,
 /// sensor_msgs/Imu -> one gyro sample (stamp and angular_velocity). Values
 /// are copied unchecked: the orientation timeline validates and counts them.
 steadiface::GyroSample ToGyroSample(const sensor_msgs::Imu& imu);
+/// sensor_msgs/Imu -> one accelerometer reading (stamp, linear_acceleration).
+/// False when the message has none: linear_acceleration_covariance[0] == -1
+/// (the message's convention for "not provided"), or all three zero.
+bool ToAccelSample(const sensor_msgs::Imu& imu, steadiface::AccelSample* out);
 
 /// Quaternion conversions. ToEigen normalizes; a zero or non-finite message
 /// quaternion yields false.

@@ -86,6 +86,7 @@ class StabilizerRos : public OutputSink {
 
   void DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s);
   void DiagRotationSource(diagnostic_updater::DiagnosticStatusWrapper& s);
+  void DiagView(diagnostic_updater::DiagnosticStatusWrapper& s);
   void DiagFace(diagnostic_updater::DiagnosticStatusWrapper& s);
   void DiagSolver(diagnostic_updater::DiagnosticStatusWrapper& s);
   void DiagFrames(diagnostic_updater::DiagnosticStatusWrapper& s);

@@ -81,6 +81,7 @@ struct WrapperCounters {
   uint64_t extrapolated = 0;            ///< processed with extrapolated gyro
   uint64_t passthrough = 0;             ///< published unstabilized (no IMU)
   uint64_t from_video = 0;              ///< rotation from the video (visual, or auto without IMU)
+  uint64_t accel_in = 0;                ///< IMU messages with an accelerometer reading
   uint64_t imu_rejected = 0;            ///< non-finite, implausible, duplicate, out of order
   uint64_t imu_gaps = 0;                ///< gaps longer than imu_gap_warn
   uint64_t time_jumps = 0;              ///< time went backwards: full reset
@@ -126,6 +127,14 @@ struct WrapperStatus {
   steadiface::VisualRotation visual;
   /// The clock offset correction applied on top of imu/time_offset [s].
   double imu_offset_applied_s = 0.0;
+  /// The level horizon: output/horizon, the last frame's report, and the
+  /// accelerometer readings the gravity estimate took and left out (far
+  /// from 1 g, not yet covered by the gyro) since the pipeline was built.
+  std::string horizon_mode = "off";
+  steadiface::PipelineFrame::Horizon horizon;
+  uint64_t accel_accepted = 0, accel_rejected = 0;
+  /// The last frame's crop (output/crop).
+  steadiface::CropReport crop;
   /// The IMU extrinsics' source, and the frames of their TF lookup.
   ExtrinsicsState extrinsics = ExtrinsicsState::kConfigured;
   std::string extrinsics_from, extrinsics_to;

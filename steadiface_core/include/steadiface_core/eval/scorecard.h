@@ -34,7 +34,8 @@ struct FrameWarp {
   Eigen::Quaterniond R_v = Eigen::Quaterniond::Identity();
   Eigen::Vector2d t = Eigen::Vector2d::Zero();
   RowRotations rows;
-  /// kComposite: the background layer's pose.
+  /// kComposite: the background layer's pose (kMesh from the layered
+  /// warp: the same, for the horizon's roll).
   Eigen::Quaterniond R_b = Eigen::Quaterniond::Identity();
   Eigen::Vector2d t_b = Eigen::Vector2d::Zero();
   Eigen::Matrix3d H = Eigen::Matrix3d::Identity();
@@ -96,6 +97,10 @@ struct Score {
   double distortion = 1.0;
   /// Fraction of frames with any undefined output pixel.
   double undefined_fraction = 0.0;
+  /// The horizon: RMS over frames of the output's roll against the true
+  /// gravity (the scene's layer: R_v for kPose, R_b for kComposite and
+  /// kMesh), and of the input's [deg]. NaN for other warps.
+  double output_roll_rms_deg = NAN, input_roll_rms_deg = NAN;
   /// Jitter of the far background where it is visible: a denser grid of
   /// directions, each point dropped on frames where the subject (face or
   /// torso) covers it, mean over the points [output px]. The fair
@@ -184,6 +189,8 @@ class Scorecard {
   double CentreDistortion(const FrameWarp& w) const;
   bool Undefined(const FrameWarp& w, Sample* s) const;
   void AddStageTimes(const FrameWarp& w);
+  // The output's and the input's roll against the true gravity.
+  void AddRoll(const sim::SimTruth& truth, const FrameWarp& w);
   // Compute's pieces: the background figures (trajectories scored on runs
   // of at least min_run frames) and the lines', cells' and steps' figures.
   void ComputeBackground(double fps, size_t min_run, double diag, Score* sc) const;
@@ -204,6 +211,7 @@ class Scorecard {
   OutputGeometry frame_output_;
   ProtrusionGeometry frame_protrusion_;
   std::vector<double> kept_width_;  // per frame, 1 - 2 r
+  std::vector<double> output_roll_, input_roll_;  // per frame [rad]
   std::vector<Eigen::Vector3d> background_dirs_;
   std::vector<Eigen::Vector3d> visible_dirs_;
   std::vector<std::vector<Eigen::Vector2d>> visible_out_;  // [point][frame]

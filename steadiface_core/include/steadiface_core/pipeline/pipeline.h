@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,6 +17,7 @@
 #include "steadiface_core/gyro/orientation_timeline.h"
 #include "steadiface_core/stabilizer/stabilizer.h"
 #include "steadiface_core/view/dynamic_crop.h"
+#include "steadiface_core/view/gravity.h"
 #include "steadiface_core/view/shake_path.h"
 #include "steadiface_core/visual/visual_rotation.h"
 #include "steadiface_core/warp/warper.h"
@@ -61,6 +64,8 @@ struct PipelineOptions {
   /// The output's crop: warp.output.crop_ratio on every frame (kFixed), or
   /// a dynamic crop between crop.widest_crop_ratio and it.
   DynamicCropOptions crop;
+  /// The level horizon from the accelerometer (off by default).
+  HorizonOptions horizon;
   /// The composite (warp mode composite): matte, plate, blend.
   CompositeOptions composite;
   /// Produce the stabilized image (false: poses only, e.g. for scoring).
@@ -122,6 +127,22 @@ struct PipelineFrame {
   /// The crop the frame was made with, and the dynamic crop's need and
   /// target.
   CropReport crop;
+  /// The level horizon (output/horizon).
+  struct Horizon {
+    HorizonMode mode = HorizonMode::kOff;
+    /// E_h was in the solve: gravity known, the rotation from the gyro.
+    bool active = false;
+    /// Why not, when the mode asks for it: "no accelerometer" (gravity not
+    /// known yet: no or only rejected readings) or "visual rotation"; empty
+    /// otherwise.
+    std::string inactive_reason;
+    /// The roll against gravity of the output's scene (the background
+    /// layer's pose where there is one) and of the real camera (middle row)
+    /// [rad], HorizonRoll; NaN while gravity is not known.
+    double output_roll_rad = NAN;
+    double real_roll_rad = NAN;
+  };
+  Horizon horizon;
   PipelineTimings timings;
   /// The gyro-vs-video check over its window (GyroVideoCheck).
   GyroVideoCheckResult gyro_video_check;
@@ -156,6 +177,12 @@ class Pipeline {
 
   /// Buffers one gyro sample (rejections are counted in timeline stats).
   SampleResult AddGyro(const GyroSample& sample);
+  /// Takes one accelerometer reading (after the gyro sample of the same
+  /// message): gravity for the level horizon. Returns true when it was
+  /// accepted (HorizonOptions: near 1 g, covered by the gyro).
+  bool AddAccel(const AccelSample& sample);
+  /// The gravity estimate's counters (accepted, rejected readings).
+  const GravityEstimator& gravity() const { return gravity_; }
   /// rotation_source kAuto: whether the next frames lack IMU data (the
   /// gyro does not cover them), so that their rotation comes from the
   /// video. Ignored in the other modes.
@@ -238,6 +265,9 @@ class Pipeline {
   Status VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f);
   Pipeline(const CameraModel& model, const PipelineOptions& options);
   void ApplyOffsetEstimate(Time stamp);
+  // The level horizon for this frame's solve, and its report.
+  void HorizonStep(PipelineFrame* f);
+  void HorizonReportStep(PipelineFrame* f) const;
   // The dynamic crop: the margin this frame's solved pose(s) asked for
   // moves the next frame's crop (kFixed: the report only).
   void CropStep(Time stamp, PipelineFrame* f);
@@ -259,6 +289,7 @@ class Pipeline {
   std::unique_ptr<Compositor> compositor_;       // composite mode
   std::unique_ptr<DynamicCrop> crop_;
   ShakePath shake_path_;  // the dynamic crop's room for the shake
+  GravityEstimator gravity_;  // the level horizon's gravity
   bool has_crop_stamp_ = false;
   Time crop_stamp_;
   cv::Mat subject_picture_;                      // composite: the subject layer's

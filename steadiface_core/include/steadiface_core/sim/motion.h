@@ -43,6 +43,10 @@ struct CameraMotionOptions {
   double shake_lo_hz = 1.0, shake_hi_hz = 12.0;
   /// Hand translation RMS per axis [m], band 0.3-3 Hz.
   double translation_rms_m = 0.004;
+  /// A slow roll about the optical axis: amplitude [rad] and frequency
+  /// [Hz] of roll(t) = amplitude sin(2 pi hz t) (the horizon tilting).
+  double roll_amplitude_rad = 0.0;
+  double roll_hz = 0.2;
   uint64_t seed = 1;
 };
 

@@ -13,6 +13,7 @@
 #include "steadiface_core/gyro/orientation_timeline.h"
 #include "steadiface_core/sim/motion.h"
 #include "steadiface_core/sim/scene_renderer.h"
+#include "steadiface_core/view/gravity.h"
 
 namespace steadiface {
 namespace sim {
@@ -93,6 +94,9 @@ struct SimulatorOptions {
   double gyro_noise = 0.002;
   Eigen::Vector3d gyro_bias = Eigen::Vector3d(0.001, -0.0015, 0.0005);
   double imu_jitter_s = 0.0002;
+  /// Accelerometer white noise [m/s^2] (the readings: the specific force,
+  /// gravity along the world's +y, "down", and the camera's acceleration).
+  double accel_noise = 0.03;
   double imu_clock_offset_s = 0.0;
   /// Events (times in seconds from the start; negative = never).
   double occlusion_start_s = -1, occlusion_end_s = -1;
@@ -112,7 +116,8 @@ struct SimulatorOptions {
 /// walk_across, bob (a walking selfie whose head bobs against the scene by
 /// +-100 px at 720p, with neck and shoulders: what the composite is judged
 /// on), hair (vlog with hair strands at the head's top edge), passer_by
-/// (walk with neck and shoulders, a person walking across behind).
+/// (walk with neck and shoulders, a person walking across behind), roll
+/// (walk under a slow +-10 deg roll: what the level horizon is judged on).
 Status ApplyPreset(const std::string& name, SimulatorOptions* options);
 const std::vector<std::string>& PresetNames();
 
@@ -149,6 +154,11 @@ class Simulator {
   const RowTiming& timing() const { return timing_; }
   /// Gyro samples as the IMU reports them (camera axes, IMU clock).
   const std::vector<GyroSample>& imu() const { return imu_; }
+  /// Accelerometer readings at the gyro's stamps (camera axes, IMU clock).
+  const std::vector<AccelSample>& accel() const { return accel_; }
+  /// Gravity's "up" in the camera at time t [s] (the world is level: up is
+  /// its -y).
+  Eigen::Vector3d UpInCamera(double t) const;
   const SimulatorOptions& options() const { return options_; }
 
   /// Renders frame i (BGR) and its truth.
@@ -205,6 +215,7 @@ class Simulator {
   void MakePasserBy();
   Eigen::Vector2d face_centre_uv_ = Eigen::Vector2d::Zero();
   std::vector<GyroSample> imu_;
+  std::vector<AccelSample> accel_;
 };
 
 /// Loads a deepfvs gyro log ("t_us gx gy gz ...") as camera-frame samples

@@ -31,8 +31,9 @@ struct TermEnergies {
   double rotation = 0.0;
   double translation = 0.0;
   double protrusion = 0.0;
+  double horizon = 0.0;  ///< E_h (ours: the level horizon), 0 when off
   double total() const {
-    return fit + distortion + follow + rotation + translation + protrusion;
+    return fit + distortion + follow + rotation + translation + protrusion + horizon;
   }
 };
 
@@ -117,6 +118,17 @@ struct StabilizerFrame {
   LayerPose background;
 };
 
+/// The level horizon for the frames to come (the pipeline's output/horizon):
+/// gravity's "up" in the gyro's world frame, the weight w_h of E_h, and
+/// whether E_d and E_o measure the virtual camera against the real one
+/// turned level about its optical axis (lock: the roll is not followed).
+struct HorizonTarget {
+  bool active = false;
+  Eigen::Vector3d up_world = Eigen::Vector3d(0.0, -1.0, 0.0);
+  double weight = 0.0;
+  bool level_reference = false;
+};
+
 /// Running counters since start (reset() keeps them).
 struct StabilizerStats {
   uint64_t frames = 0;
@@ -166,6 +178,10 @@ class Stabilizer {
   /// within min(subject_reach, this) of where the background layer shows the
   /// face. <= 0: subject_reach alone.
   void SetReachLimit(double jaw_widths) { reach_limit_ = jaw_widths; }
+
+  /// The level horizon from the next Process() on (both layers); an
+  /// inactive target (the default) leaves the roll to the paper's terms.
+  void SetHorizon(const HorizonTarget& horizon) { horizon_ = horizon; }
 
   /// The dynamic crop: the window E_p, the protrusion search and Eq. 1's
   /// margin keep inside the real frame, from the next Process() on, is
@@ -264,6 +280,9 @@ class Stabilizer {
   // The background layer for this frame (rows from the subject's frame).
   void BackgroundLayer(Time stamp, const OrientationTimeline& timeline, const RowTiming& timing,
                        StabilizerFrame* f);
+  // The rotation E_d and E_o measure the virtual camera against: the real
+  // one, or with a locked horizon the real one turned level.
+  Eigen::Quaterniond HorizonReference(const Eigen::Quaterniond& R_r) const;
   // Every term's energy at the final pose.
   void EnergiesStep(const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
                     PoseProblem* problem, StabilizerFrame* f) const;
@@ -274,6 +293,7 @@ class Stabilizer {
   // The crop in effect (SetCropRatio) and its protrusion boundary.
   OutputGeometry output_;
   ProtrusionGeometry protrusion_;
+  HorizonTarget horizon_;
   StabilizerOptions options_;
   HeadSmoother smoother_;
   DynamicWeights dynamic_;
