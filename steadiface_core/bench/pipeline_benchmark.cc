@@ -65,9 +65,13 @@ void BM_PipelineFrame(benchmark::State& state) {
   if (state.range(3) == 1) po.warp.mode = WarpMode::kLayered;
   if (state.range(3) == 2) po.warp.mode = WarpMode::kComposite;
   if (state.range(4) == 1) po.rotation_source = RotationSource::kVisual;
+  if (state.range(5) == 1) {
+    po.crop.mode = CropMode::kDynamic;
+    po.horizon.mode = HorizonMode::kLevel;
+  }
   std::unique_ptr<Pipeline> p;
   size_t g = 0, i = 0;
-  std::vector<double> face, stab, warp, mesh, composite, matte, plate, blend, total, visual;
+  std::vector<double> face, stab, warp, mesh, composite, matte, plate, blend, total, visual, crop;
   double check_sum = 0.0, check_max = 0.0;
   // A fresh pipeline that has acquired the face on the first frame.
   auto restart = [&]() -> bool {
@@ -108,6 +112,7 @@ void BM_PipelineFrame(benchmark::State& state) {
     blend.push_back(out.composite.report.blend_ms);
     total.push_back(out.timings.total_ms);
     visual.push_back(out.visual.ms);
+    crop.push_back(out.timings.crop_ms);
     check_sum += out.timings.check_ms;
     check_max = std::max(check_max, out.timings.check_ms);
   }
@@ -120,6 +125,7 @@ void BM_PipelineFrame(benchmark::State& state) {
   state.counters["plate_ms"] = Percentile(plate, 0.5);
   state.counters["blend_ms"] = Percentile(blend, 0.5);
   state.counters["visual_ms"] = Percentile(visual, 0.5);
+  state.counters["crop_ms"] = Percentile(crop, 0.5);
   // The gyro-vs-video check runs on one frame pair in `stride`: its mean
   // per frame, and the checked frames' cost.
   state.counters["check_mean_ms"] = total.empty() ? 0.0 : check_sum / total.size();
@@ -131,22 +137,26 @@ void BM_PipelineFrame(benchmark::State& state) {
 }
 
 BENCHMARK(BM_PipelineFrame)
-    ->Args({640, 360, 1, 0, 0})
-    ->Args({1280, 720, 1, 0, 0})
-    ->Args({1920, 1080, 1, 0, 0})
-    ->Args({640, 360, 2, 0, 0})
-    ->Args({1280, 720, 2, 0, 0})
-    ->Args({1920, 1080, 2, 0, 0})
-    ->Args({640, 360, 1, 1, 0})
-    ->Args({1280, 720, 1, 1, 0})
-    ->Args({1920, 1080, 1, 1, 0})
-    ->Args({640, 360, 1, 2, 0})
-    ->Args({1280, 720, 1, 2, 0})
-    ->Args({1920, 1080, 1, 2, 0})
-    ->Args({640, 360, 1, 0, 1})
-    ->Args({1280, 720, 1, 0, 1})
-    ->Args({1920, 1080, 1, 0, 1})
-    ->ArgNames({"w", "h", "threads", "mode", "rotation"})
+    ->Args({640, 360, 1, 0, 0, 0})
+    ->Args({1280, 720, 1, 0, 0, 0})
+    ->Args({1920, 1080, 1, 0, 0, 0})
+    ->Args({640, 360, 2, 0, 0, 0})
+    ->Args({1280, 720, 2, 0, 0, 0})
+    ->Args({1920, 1080, 2, 0, 0, 0})
+    ->Args({640, 360, 1, 1, 0, 0})
+    ->Args({1280, 720, 1, 1, 0, 0})
+    ->Args({1920, 1080, 1, 1, 0, 0})
+    ->Args({640, 360, 1, 2, 0, 0})
+    ->Args({1280, 720, 1, 2, 0, 0})
+    ->Args({1920, 1080, 1, 2, 0, 0})
+    ->Args({640, 360, 1, 0, 1, 0})
+    ->Args({1280, 720, 1, 0, 1, 0})
+    ->Args({1920, 1080, 1, 0, 1, 0})
+    // The view: the dynamic crop and the level horizon, against the same
+    // size and mode with neither (view 0).
+    ->Args({1280, 720, 1, 0, 0, 1})
+    ->Args({1280, 720, 1, 1, 0, 1})
+    ->ArgNames({"w", "h", "threads", "mode", "rotation", "view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -272,3 +272,16 @@ TEST(ExampleOverlaysTest, PhoneFrontCameraIsAHalfTurnAboutTheOpticalAxis) {
 
 }  // namespace
 }  // namespace steadiface_ros
+
+namespace steadiface_ros {
+namespace {
+
+TEST(ExampleOverlaysTest, ViewTurnsOnTheDynamicCropAndTheLevelHorizon) {
+  const Loaded l = LoadExample("view.yaml");
+  EXPECT_EQ(l.po.crop.mode, steadiface::CropMode::kDynamic);
+  EXPECT_EQ(l.po.horizon.mode, steadiface::HorizonMode::kLevel);
+  EXPECT_DOUBLE_EQ(l.po.warp.output.crop_ratio, 0.15);  // the tightest, unchanged
+}
+
+}  // namespace
+}  // namespace steadiface_ros

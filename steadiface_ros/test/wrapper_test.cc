@@ -27,18 +27,26 @@ struct Sink : public OutputSink {
   std::vector<steadiface::FaceLandmarks> landmarks;
   std::vector<geometry_msgs::TransformStamped> tf;
   std::map<std::string, int> warnings, errors;
-  void PublishImage(const sensor_msgs::ImagePtr& i, const sensor_msgs::CameraInfoPtr& c) override {
+  void PublishImage(const sensor_msgs::ImagePtr& i,
+                    const sensor_msgs::CameraInfoPtr& c) override {
     images.push_back(i);
     infos.push_back(c);
   }
-  void PublishLandmarks(const steadiface::FaceLandmarks& m) override { landmarks.push_back(m); }
-  void PublishState(const steadiface::StabilizerState& m) override { states.push_back(m); }
-  void PublishTf(const std::vector<geometry_msgs::TransformStamped>& t) override {
+  void PublishLandmarks(const steadiface::FaceLandmarks& m) override {
+    landmarks.push_back(m);
+  }
+  void PublishState(const steadiface::StabilizerState& m) override {
+    states.push_back(m);
+  }
+  void PublishTf(
+      const std::vector<geometry_msgs::TransformStamped>& t) override {
     tf.insert(tf.end(), t.begin(), t.end());
   }
   bool WantsDebugImage() const override { return false; }
   void PublishDebugImage(const sensor_msgs::ImagePtr&) override {}
-  void Warn(const std::string& k, const std::string&) override { ++warnings[k]; }
+  void Warn(const std::string& k, const std::string&) override {
+    ++warnings[k];
+  }
   void Error(const std::string& k, const std::string&) override { ++errors[k]; }
 };
 
@@ -63,13 +71,18 @@ const Stream& TestStream() {
     EXPECT_TRUE(steadiface::sim::Simulator::Create(o, &sim).ok());
     st.readout = o.readout_s;
     const ros::Duration shift(1000.0);
-    for (const auto& g : sim->imu()) {
+    for (size_t i = 0; i < sim->imu().size(); ++i) {
+      const steadiface::GyroSample& g = sim->imu()[i];
       sensor_msgs::Imu m;
       m.header.stamp = ToRosTime(g.stamp) + shift;
       m.header.frame_id = "cam";
       m.angular_velocity.x = g.angular_velocity.x();
       m.angular_velocity.y = g.angular_velocity.y();
       m.angular_velocity.z = g.angular_velocity.z();
+      const Eigen::Vector3d& a = sim->accel()[i].linear_acceleration;
+      m.linear_acceleration.x = a.x();
+      m.linear_acceleration.y = a.y();
+      m.linear_acceleration.z = a.z();
       st.imu.push_back(m);
     }
     const steadiface::CameraIntrinsics& k = sim->intrinsics();
@@ -95,7 +108,8 @@ const Stream& TestStream() {
 steadiface::PipelineOptions Options() {
   steadiface::PipelineOptions o;
   o.shutter.readout_time_s = TestStream().readout;
-  o.landmark_source = steadiface::LandmarkSource::kNone;  // fast; faces are tested elsewhere
+  o.landmark_source =
+      steadiface::LandmarkSource::kNone;  // fast; faces are tested elsewhere
   return o;
 }
 
@@ -106,9 +120,11 @@ void Feed(StabilizerWrapper* w, const Stream& s, int from = 0, int to = -1,
   if (to < 0) to = static_cast<int>(s.images.size());
   size_t g = 0;
   const ros::Time first = s.images[from]->header.stamp;
-  while (g < s.imu.size() && s.imu[g].header.stamp < first - ros::Duration(0.2)) ++g;
+  while (g < s.imu.size() && s.imu[g].header.stamp < first - ros::Duration(0.2))
+    ++g;
   for (int i = from; i < to; ++i) {
-    const ros::Time last_row = s.images[i]->header.stamp + ros::Duration(s.readout + 0.006);
+    const ros::Time last_row =
+        s.images[i]->header.stamp + ros::Duration(s.readout + 0.006);
     while (g < s.imu.size() && s.imu[g].header.stamp <= last_row) {
       sensor_msgs::Imu m = s.imu[g++];
       if (imu_fault) imu_fault(&m);
@@ -124,15 +140,17 @@ void Feed(StabilizerWrapper* w, const Stream& s, int from = 0, int to = -1,
 
 void ExpectAllFinite(const Sink& sink) {
   for (const auto& s : sink.states) {
-    for (double v : {s.virtual_rotation.x, s.virtual_rotation.y, s.virtual_rotation.z,
-                     s.virtual_rotation.w, s.principal_offset[0], s.principal_offset[1],
-                     s.energy_fit, s.w_fit, s.total_ms}) {
+    for (double v :
+         {s.virtual_rotation.x, s.virtual_rotation.y, s.virtual_rotation.z,
+          s.virtual_rotation.w, s.principal_offset[0], s.principal_offset[1],
+          s.energy_fit, s.w_fit, s.total_ms}) {
       ASSERT_TRUE(std::isfinite(v));
     }
   }
   for (const auto& t : sink.tf) {
     const auto& q = t.transform.rotation;
-    ASSERT_TRUE(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w));
+    ASSERT_TRUE(std::isfinite(q.x) && std::isfinite(q.y) &&
+                std::isfinite(q.z) && std::isfinite(q.w));
   }
   for (const auto& c : sink.infos) {
     for (double v : c->K) ASSERT_TRUE(std::isfinite(v));
@@ -152,7 +170,8 @@ TEST(WrapperTest, CleanStreamIsStabilizedFrameByFrame) {
     if (t.child_frame_id == "cam_stabilized") stamps.push_back(t.header.stamp);
   }
   ASSERT_EQ(stamps.size(), TestStream().images.size());
-  for (size_t i = 1; i < stamps.size(); ++i) EXPECT_GT(stamps[i], stamps[i - 1]);
+  for (size_t i = 1; i < stamps.size(); ++i)
+    EXPECT_GT(stamps[i], stamps[i - 1]);
 }
 
 // The TF tree stays a tree: the camera frame keeps the parent its driver or
@@ -166,7 +185,8 @@ TEST(WrapperTest, TransformsNeverGiveTheCameraFrameAParent) {
   StabilizerWrapper w(po, WrapperOptions(), &sink);
   Feed(&w, TestStream());
   std::map<std::string, std::set<std::string>> parents;
-  for (const auto& t : sink.tf) parents[t.child_frame_id].insert(t.header.frame_id);
+  for (const auto& t : sink.tf)
+    parents[t.child_frame_id].insert(t.header.frame_id);
   EXPECT_EQ(parents.count("cam"), 0u);
   for (const auto& [child, p] : parents) EXPECT_EQ(p.size(), 1u) << child;
   ASSERT_EQ(parents["cam_world"], std::set<std::string>{"cam"});
@@ -178,7 +198,8 @@ TEST(WrapperTest, TransformsNeverGiveTheCameraFrameAParent) {
     ASSERT_LT(k, sink.states.size());
     const auto& a = t.transform.rotation;
     const auto& b = sink.states[k++].real_rotation;
-    EXPECT_NEAR(std::abs(a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w), 1.0, 1e-9);
+    EXPECT_NEAR(std::abs(a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w), 1.0,
+                1e-9);
   }
   EXPECT_EQ(k, sink.states.size());
   // A configured world frame is used as it is.
@@ -198,10 +219,12 @@ TEST(WrapperTest, TransformsNeverGiveTheCameraFrameAParent) {
 // rotation is taken, the pipeline rebuilt once, and from then on the
 // frame-to-frame real rotation is that of an IMU in the camera's frame.
 TEST(WrapperTest, LateImuExtrinsicsAreTakenWhenTfHasThem) {
-  const Eigen::Quaterniond R_cam_imu(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond R_cam_imu(
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
   Stream rotated = TestStream();
   for (auto& m : rotated.imu) {
-    const Eigen::Vector3d w_cam(m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
+    const Eigen::Vector3d w_cam(m.angular_velocity.x, m.angular_velocity.y,
+                                m.angular_velocity.z);
     const Eigen::Vector3d w_imu = R_cam_imu.conjugate() * w_cam;
     m.angular_velocity.x = w_imu.x();
     m.angular_velocity.y = w_imu.y();
@@ -212,7 +235,8 @@ TEST(WrapperTest, LateImuExtrinsicsAreTakenWhenTfHasThem) {
   size_t resolved_at = 0;  // states published when TF had it
   std::string asked_from, asked_to;
   Sink sink, truth_sink;
-  auto lookup = [&](const std::string& from, const std::string& to, Eigen::Quaterniond* q) {
+  auto lookup = [&](const std::string& from, const std::string& to,
+                    Eigen::Quaterniond* q) {
     asked_from = from, asked_to = to;
     if (++asked <= 20) return false;  // the static TF is not there yet
     resolved_at = sink.states.size();
@@ -260,14 +284,17 @@ TEST(WrapperTest, MissingLandmarkModelFallsBackToGyroOnly) {
   Feed(&off, TestStream());
   steadiface::PipelineOptions o = Options();
   o.landmark_source = steadiface::LandmarkSource::kDlib;
-  o.face.landmark_model_path = "/nonexistent/shape_predictor_68_face_landmarks.dat";
+  o.face.landmark_model_path =
+      "/nonexistent/shape_predictor_68_face_landmarks.dat";
   StabilizerWrapper missing(o, WrapperOptions(), &missing_sink);
-  EXPECT_EQ(missing.pipeline_options().landmark_source, steadiface::LandmarkSource::kNone);
+  EXPECT_EQ(missing.pipeline_options().landmark_source,
+            steadiface::LandmarkSource::kNone);
   Feed(&missing, TestStream());
   EXPECT_EQ(missing_sink.errors["landmark_model"], 1);
   EXPECT_EQ(missing_sink.errors.count("pipeline"), 0u);
   const std::string why = missing.Status().landmark_model_error;
-  EXPECT_NE(why.find("/nonexistent/shape_predictor_68_face_landmarks.dat"), std::string::npos);
+  EXPECT_NE(why.find("/nonexistent/shape_predictor_68_face_landmarks.dat"),
+            std::string::npos);
   EXPECT_NE(why.find("apt-get install libdlib-data"), std::string::npos) << why;
   EXPECT_TRUE(off.Status().landmark_model_error.empty());
   ASSERT_EQ(missing_sink.states.size(), TestStream().images.size());
@@ -290,7 +317,9 @@ TEST(WrapperTest, MissingLandmarkModelFallsBackToGyroOnly) {
 TEST(WrapperTest, SinkWithoutImagesGetsTheSameInfosAndStates) {
   struct InfoOnlySink : public Sink {
     bool WantsImage() const override { return false; }
-    void PublishOutputInfo(const sensor_msgs::CameraInfoPtr& c) override { infos.push_back(c); }
+    void PublishOutputInfo(const sensor_msgs::CameraInfoPtr& c) override {
+      infos.push_back(c);
+    }
   };
   for (bool pipelined : {false, true}) {
     Sink a;
@@ -311,7 +340,8 @@ TEST(WrapperTest, SinkWithoutImagesGetsTheSameInfosAndStates) {
       EXPECT_EQ(b.infos[i]->height, a.infos[i]->height);
       EXPECT_TRUE(b.infos[i]->K == a.infos[i]->K) << "frame " << i;
       EXPECT_EQ(b.states[i].virtual_rotation.w, a.states[i].virtual_rotation.w);
-      EXPECT_EQ(b.states[i].principal_offset[0], a.states[i].principal_offset[0]);
+      EXPECT_EQ(b.states[i].principal_offset[0],
+                a.states[i].principal_offset[0]);
     }
     ASSERT_EQ(b.tf.size(), a.tf.size());
   }
@@ -322,8 +352,9 @@ TEST(WrapperTest, SinkWithoutImagesGetsTheSameInfosAndStates) {
 // one-stage wrapper; each frame is published by the next one or by the
 // hold / flush, never lost; in layered mode too.
 TEST(WrapperTest, PipelinedPublishesTheSameFramesInOrder) {
-  for (steadiface::WarpMode mode : {steadiface::WarpMode::kGlobal, steadiface::WarpMode::kLayered,
-                                    steadiface::WarpMode::kComposite}) {
+  for (steadiface::WarpMode mode :
+       {steadiface::WarpMode::kGlobal, steadiface::WarpMode::kLayered,
+        steadiface::WarpMode::kComposite}) {
     steadiface::PipelineOptions po = Options();
     po.warp.mode = mode;
     Sink a, b;
@@ -353,8 +384,10 @@ TEST(WrapperTest, PipelinedPublishesTheSameFramesInOrder) {
   StabilizerWrapper wc(Options(), held, &c);
   const Stream& s = TestStream();
   size_t g = 0;
-  const ros::Time last_row = s.images[0]->header.stamp + ros::Duration(s.readout + 0.006);
-  while (g < s.imu.size() && s.imu[g].header.stamp <= last_row) wc.OnImu(s.imu[g++]);
+  const ros::Time last_row =
+      s.images[0]->header.stamp + ros::Duration(s.readout + 0.006);
+  while (g < s.imu.size() && s.imu[g].header.stamp <= last_row)
+    wc.OnImu(s.imu[g++]);
   wc.OnImage(s.images[0], s.info, s.images[0]->header.stamp);
   EXPECT_EQ(c.images.size(), 0u);  // rendering, held for its successor
   wc.OnTimer(s.images[0]->header.stamp + ros::Duration(0.11));
@@ -383,7 +416,8 @@ TEST(WrapperTest, BackgroundLayerIsPublishedAsItsOwnFrameWhenOn) {
     return n;
   };
   EXPECT_EQ(count(off_sink, "cam_stabilized_background"), 0u);
-  EXPECT_EQ(count(on_sink, "cam_stabilized_background"), TestStream().images.size());
+  EXPECT_EQ(count(on_sink, "cam_stabilized_background"),
+            TestStream().images.size());
   EXPECT_EQ(count(on_sink, "cam_stabilized"), TestStream().images.size());
   ASSERT_EQ(on_sink.states.size(), gyro_sink.states.size());
   ASSERT_EQ(on_sink.states.size(), off_sink.states.size());
@@ -393,7 +427,8 @@ TEST(WrapperTest, BackgroundLayerIsPublishedAsItsOwnFrameWhenOn) {
     ASSERT_TRUE(a.has_background_layer);
     EXPECT_EQ(a.background_rotation.x, gyro_sink.states[i].virtual_rotation.x);
     EXPECT_EQ(a.background_rotation.w, gyro_sink.states[i].virtual_rotation.w);
-    EXPECT_EQ(a.background_principal_offset[1], gyro_sink.states[i].principal_offset[1]);
+    EXPECT_EQ(a.background_principal_offset[1],
+              gyro_sink.states[i].principal_offset[1]);
     // The subject layer is as with one layer.
     EXPECT_EQ(a.virtual_rotation.z, off_sink.states[i].virtual_rotation.z);
   }
@@ -408,11 +443,14 @@ TEST(WrapperTest, LayeredModePublishesBothLayersAndSwitchesBackToGlobal) {
   struct DebugSink : public Sink {
     std::vector<sensor_msgs::ImagePtr> debug;
     bool WantsDebugImage() const override { return true; }
-    void PublishDebugImage(const sensor_msgs::ImagePtr& i) override { debug.push_back(i); }
+    void PublishDebugImage(const sensor_msgs::ImagePtr& i) override {
+      debug.push_back(i);
+    }
   };
   DebugSink sink;
   steadiface::PipelineOptions po = Options();
-  po.landmark_source = steadiface::LandmarkSource::kDlib;  // the region needs a face
+  po.landmark_source =
+      steadiface::LandmarkSource::kDlib;  // the region needs a face
   po.warp.mode = steadiface::WarpMode::kLayered;
   StabilizerWrapper w(po, WrapperOptions(), &sink);
   const int n = static_cast<int>(TestStream().images.size());
@@ -425,7 +463,8 @@ TEST(WrapperTest, LayeredModePublishesBothLayersAndSwitchesBackToGlobal) {
   Feed(&gyro, TestStream(), 0, n / 2);
   ASSERT_EQ(sink.states.size(), static_cast<size_t>(n / 2));
   size_t background_tf = 0;
-  for (const auto& t : sink.tf) background_tf += t.child_frame_id == "cam_stabilized_background";
+  for (const auto& t : sink.tf)
+    background_tf += t.child_frame_id == "cam_stabilized_background";
   EXPECT_EQ(background_tf, sink.states.size());
   bool blended = false;
   for (size_t i = 0; i < sink.states.size(); ++i) {
@@ -447,7 +486,8 @@ TEST(WrapperTest, LayeredModePublishesBothLayersAndSwitchesBackToGlobal) {
   ASSERT_FALSE(sink.debug.empty());
   ExpectAllFinite(sink);
   // Back to global at run time.
-  w.RequestLayering(steadiface::WarpMode::kGlobal, steadiface::LayeredWarpOptions());
+  w.RequestLayering(steadiface::WarpMode::kGlobal,
+                    steadiface::LayeredWarpOptions());
   Feed(&w, TestStream(), n / 2, n);
   ASSERT_EQ(sink.states.size(), static_cast<size_t>(n));
   EXPECT_EQ(sink.states.back().warp_mode, "global");
@@ -463,11 +503,14 @@ TEST(WrapperTest, CompositeModeSwitchedOnAtRunTimePublishesItsState) {
   struct DebugSink : public Sink {
     std::vector<sensor_msgs::ImagePtr> debug;
     bool WantsDebugImage() const override { return true; }
-    void PublishDebugImage(const sensor_msgs::ImagePtr& i) override { debug.push_back(i); }
+    void PublishDebugImage(const sensor_msgs::ImagePtr& i) override {
+      debug.push_back(i);
+    }
   };
   DebugSink sink;
   steadiface::PipelineOptions po = Options();
-  po.landmark_source = steadiface::LandmarkSource::kDlib;  // the matte needs a face
+  po.landmark_source =
+      steadiface::LandmarkSource::kDlib;  // the matte needs a face
   StabilizerWrapper w(po, WrapperOptions(), &sink);
   const int n = static_cast<int>(TestStream().images.size());
   Feed(&w, TestStream(), 0, n / 4);
@@ -517,13 +560,16 @@ TEST(WrapperTest, StateReportsLatencyAndItsParts) {
   for (int i = 0; i < 10; ++i) {
     const ros::Time stamp = s.images[i]->header.stamp;
     // Gyro up to the first row only: the frame must wait.
-    while (g < s.imu.size() && s.imu[g].header.stamp <= stamp) w.OnImu(s.imu[g++]);
+    while (g < s.imu.size() && s.imu[g].header.stamp <= stamp)
+      w.OnImu(s.imu[g++]);
     sink.now = stamp + ros::Duration(0.020);
     w.OnImage(s.images[i], s.info, sink.now);
-    EXPECT_EQ(sink.states.size(), static_cast<size_t>(i)) << "processed before the gyro covered it";
+    EXPECT_EQ(sink.states.size(), static_cast<size_t>(i))
+        << "processed before the gyro covered it";
     sink.now = stamp + ros::Duration(0.030);
     const ros::Time last_row = stamp + ros::Duration(s.readout + 0.006);
-    while (g < s.imu.size() && s.imu[g].header.stamp <= last_row) w.OnImu(s.imu[g++]);
+    while (g < s.imu.size() && s.imu[g].header.stamp <= last_row)
+      w.OnImu(s.imu[g++]);
     ASSERT_EQ(sink.states.size(), static_cast<size_t>(i + 1));
     const steadiface::StabilizerState& st = sink.states.back();
     EXPECT_NEAR(st.arrival_latency_ms, 20.0, 1e-3);
@@ -547,10 +593,10 @@ TEST(WrapperTest, ImuFaultsAreRejectedCountedAndHarmless) {
   int k = 0;
   Feed(&w, TestStream(), 0, -1, [&](sensor_msgs::Imu* m) {
     ++k;
-    if (k % 17 == 0) m->angular_velocity.x = kNaN;                  // NaN
-    if (k % 23 == 0) m->angular_velocity.y = INFINITY;              // Inf
-    if (k % 29 == 0) m->header.stamp -= ros::Duration(0.0001);     // out of order
-    if (k % 31 == 0) m->angular_velocity.z = 1e4;                   // implausible
+    if (k % 17 == 0) m->angular_velocity.x = kNaN;              // NaN
+    if (k % 23 == 0) m->angular_velocity.y = INFINITY;          // Inf
+    if (k % 29 == 0) m->header.stamp -= ros::Duration(0.0001);  // out of order
+    if (k % 31 == 0) m->angular_velocity.z = 1e4;               // implausible
   });
   const WrapperStatus s = w.Status();
   EXPECT_GT(s.counters.imu_rejected, 20u);
@@ -562,18 +608,23 @@ TEST(WrapperTest, ImuFaultsAreRejectedCountedAndHarmless) {
 }
 
 TEST(WrapperTest, ImuGapIsWarnedAndFramesExtrapolatedOrDropped) {
-  for (steadiface::LateFramePolicy policy : {steadiface::LateFramePolicy::kExtrapolate, steadiface::LateFramePolicy::kDrop}) {
+  for (steadiface::LateFramePolicy policy :
+       {steadiface::LateFramePolicy::kExtrapolate,
+        steadiface::LateFramePolicy::kDrop}) {
     Sink sink;
     WrapperOptions wo;
     wo.scheduler.late_frame_policy = policy;
     steadiface::PipelineOptions po = Options();
     po.imu.max_extrapolation_s = 0.05;
-    po.rotation_source = steadiface::RotationSource::kImu;  // auto: the video fills gaps
+    po.rotation_source =
+        steadiface::RotationSource::kImu;  // auto: the video fills gaps
     StabilizerWrapper w(po, wo, &sink);
     const Stream& st = TestStream();
-    const ros::Time gap_from = st.images[20]->header.stamp, gap_to = st.images[24]->header.stamp;
+    const ros::Time gap_from = st.images[20]->header.stamp,
+                    gap_to = st.images[24]->header.stamp;
     Feed(&w, st, 0, -1, [&](sensor_msgs::Imu* m) {
-      if (m->header.stamp > gap_from && m->header.stamp < gap_to) m->angular_velocity.x = kNaN;
+      if (m->header.stamp > gap_from && m->header.stamp < gap_to)
+        m->angular_velocity.x = kNaN;
     });
     const WrapperStatus s = w.Status();
     EXPECT_GT(s.counters.imu_gaps, 0u);
@@ -623,10 +674,12 @@ TEST(WrapperTest, WithoutAnImuTheVideoGivesTheRotation) {
   auto turns = [](const Sink& sink) {
     std::vector<Eigen::Quaterniond> q;
     for (const auto& s : sink.states) {
-      q.emplace_back(s.real_rotation.w, s.real_rotation.x, s.real_rotation.y, s.real_rotation.z);
+      q.emplace_back(s.real_rotation.w, s.real_rotation.x, s.real_rotation.y,
+                     s.real_rotation.z);
     }
     std::vector<double> a;
-    for (size_t i = 1; i < q.size(); ++i) a.push_back(q[i].angularDistance(q[i - 1]));
+    for (size_t i = 1; i < q.size(); ++i)
+      a.push_back(q[i].angularDistance(q[i - 1]));
     return a;
   };
   Sink imu_sink;
@@ -660,7 +713,9 @@ TEST(WrapperTest, WithoutAnImuTheVideoGivesTheRotation) {
   }
   // The frame-to-frame turn (0.026 rad RMS on walk) within a fifth of it
   // (measured: 0.0019 rad).
-  std::cout << "[ frame-to-frame turn ] RMS " << std::sqrt(ref / b.size()) << " rad (gyro), error of the video's " << std::sqrt(err / a.size()) << " rad\n";
+  std::cout << "[ frame-to-frame turn ] RMS " << std::sqrt(ref / b.size())
+            << " rad (gyro), error of the video's " << std::sqrt(err / a.size())
+            << " rad\n";
   EXPECT_LT(std::sqrt(err / a.size()), 0.2 * std::sqrt(ref / b.size()));
 }
 
@@ -677,22 +732,29 @@ TEST(WrapperTest, AutoBridgesAnImuDropoutWithTheVideo) {
     const ros::Time t0 = st.images.front()->header.stamp;
     Feed(&w, st, 0, -1, [&](sensor_msgs::Imu* m) {
       const double t = (m->header.stamp - t0).toSec();
-      if (dropout && t > 0.6 && t < 1.2) m->angular_velocity.x = kNaN;  // lost: rejected
+      if (dropout && t > 0.6 && t < 1.2)
+        m->angular_velocity.x = kNaN;  // lost: rejected
     });
     return w.Status();
   };
   Sink imu, healthy;
   run(steadiface::RotationSource::kImu, false, &imu);
-  const WrapperStatus h = run(steadiface::RotationSource::kAuto, false, &healthy);
+  const WrapperStatus h =
+      run(steadiface::RotationSource::kAuto, false, &healthy);
   ASSERT_EQ(healthy.states.size(), imu.states.size());
   for (size_t i = 0; i < imu.states.size(); ++i) {
-    EXPECT_EQ(healthy.states[i].virtual_rotation, imu.states[i].virtual_rotation) << i;
-    EXPECT_EQ(healthy.states[i].principal_offset, imu.states[i].principal_offset) << i;
+    EXPECT_EQ(healthy.states[i].virtual_rotation,
+              imu.states[i].virtual_rotation)
+        << i;
+    EXPECT_EQ(healthy.states[i].principal_offset,
+              imu.states[i].principal_offset)
+        << i;
   }
   EXPECT_EQ(h.counters.from_video, 0u);
   Sink gap;
   const WrapperStatus g = run(steadiface::RotationSource::kAuto, true, &gap);
-  EXPECT_EQ(gap.states.size(), st.images.size()) << "a frame was not stabilized";
+  EXPECT_EQ(gap.states.size(), st.images.size())
+      << "a frame was not stabilized";
   EXPECT_EQ(g.counters.passthrough, 0u);
   EXPECT_GT(g.counters.from_video, 10u);
   EXPECT_LT(g.counters.from_video, st.images.size() / 2);
@@ -703,17 +765,22 @@ TEST(WrapperTest, AutoBridgesAnImuDropoutWithTheVideo) {
   for (size_t i = 1; i < gap.states.size(); ++i) {
     const auto& a = gap.states[i - 1].virtual_rotation;
     const auto& b = gap.states[i].virtual_rotation;
-    turn.push_back(Eigen::Quaterniond(a.w, a.x, a.y, a.z)
-                       .angularDistance(Eigen::Quaterniond(b.w, b.x, b.y, b.z)));
+    turn.push_back(
+        Eigen::Quaterniond(a.w, a.x, a.y, a.z)
+            .angularDistance(Eigen::Quaterniond(b.w, b.x, b.y, b.z)));
   }
   double steady = 0.0, handover = 0.0;
   for (size_t i = 0; i < turn.size(); ++i) {
-    const bool switched = gap.states[i + 1].rotation_source != gap.states[i].rotation_source;
-    (switched ? handover : steady) = std::max(switched ? handover : steady, turn[i]);
+    const bool switched =
+        gap.states[i + 1].rotation_source != gap.states[i].rotation_source;
+    (switched ? handover : steady) =
+        std::max(switched ? handover : steady, turn[i]);
   }
-  std::cout << "[ IMU dropout ] " << g.counters.from_video << " of " << gap.states.size()
-            << " frames rotated by the video; largest virtual turn per frame: " << steady
-            << " rad elsewhere, " << handover << " rad at the hand-overs\n";
+  std::cout << "[ IMU dropout ] " << g.counters.from_video << " of "
+            << gap.states.size()
+            << " frames rotated by the video; largest virtual turn per frame: "
+            << steady << " rad elsewhere, " << handover
+            << " rad at the hand-overs\n";
   EXPECT_GT(handover, 0.0);
   EXPECT_LE(handover, std::max(steady, 1e-9) * 1.0 + 1e-9);
 }
@@ -729,16 +796,36 @@ TEST(WrapperTest, BadImagesAreDroppedWithAReason) {
   Feed(&w, st, 0, -1, {}, [&](int i) -> sensor_msgs::ImagePtr {
     sensor_msgs::ImagePtr m = Copy(st.images[i]);
     switch (i) {
-      case 5: m->encoding = "no_such_encoding"; break;
-      case 6: m->width = m->height = 0; m->data.clear(); break;
-      case 7: m->data.resize(m->data.size() / 2); break;           // step * height != size
-      case 8: m->step = 10; break;                                 // step < width * 3
-      case 9: m->width = 100; m->step = 300; m->data.resize(300 * m->height); break;  // != camera_info
-      case 10: m->encoding = "mono16"; m->step = m->width * 2;
-               m->data.assign(m->step * m->height, 0x40); break;   // converted by cv_bridge
-      case 11: m->encoding = "32FC1"; m->step = m->width * 4;
-               m->data.assign(m->step * m->height, 0); break;      // not cleanly: refused
-      default: break;
+      case 5:
+        m->encoding = "no_such_encoding";
+        break;
+      case 6:
+        m->width = m->height = 0;
+        m->data.clear();
+        break;
+      case 7:
+        m->data.resize(m->data.size() / 2);
+        break;  // step * height != size
+      case 8:
+        m->step = 10;
+        break;  // step < width * 3
+      case 9:
+        m->width = 100;
+        m->step = 300;
+        m->data.resize(300 * m->height);
+        break;  // != camera_info
+      case 10:
+        m->encoding = "mono16";
+        m->step = m->width * 2;
+        m->data.assign(m->step * m->height, 0x40);
+        break;  // converted by cv_bridge
+      case 11:
+        m->encoding = "32FC1";
+        m->step = m->width * 4;
+        m->data.assign(m->step * m->height, 0);
+        break;  // not cleanly: refused
+      default:
+        break;
     }
     return m;
   });
@@ -758,13 +845,17 @@ TEST(WrapperTest, CameraInfoMissingOrChangingIsHandled) {
   sensor_msgs::CameraInfoPtr uncal(new sensor_msgs::CameraInfo(*st.info));
   uncal->K.fill(0.0);
   for (size_t i = 0; i < st.images.size(); ++i) {
-    while (g < st.imu.size() && st.imu[g].header.stamp <= st.images[i]->header.stamp + ros::Duration(0.03)) {
+    while (g < st.imu.size() &&
+           st.imu[g].header.stamp <=
+               st.images[i]->header.stamp + ros::Duration(0.03)) {
       w.OnImu(st.imu[g++]);
     }
     if (i == 3) {
-      w.OnImage(st.images[i], nullptr, st.images[i]->header.stamp);  // no camera_info
+      w.OnImage(st.images[i], nullptr,
+                st.images[i]->header.stamp);  // no camera_info
     } else if (i == 4) {
-      w.OnImage(st.images[i], uncal, st.images[i]->header.stamp);    // uncalibrated
+      w.OnImage(st.images[i], uncal,
+                st.images[i]->header.stamp);  // uncalibrated
     } else if (i >= 30) {
       // Resolution change mid-stream: half-size frames with matching info.
       sensor_msgs::CameraInfoPtr half(new sensor_msgs::CameraInfo(*st.info));
@@ -772,8 +863,10 @@ TEST(WrapperTest, CameraInfoMissingOrChangingIsHandled) {
       half->height /= 2;
       for (int k : {0, 2, 4, 5}) half->K[k] /= 2;
       cv::Mat small;
-      cv::resize(cv_bridge::toCvShare(st.images[i])->image, small, cv::Size(half->width, half->height));
-      sensor_msgs::ImagePtr m = cv_bridge::CvImage(st.images[i]->header, "bgr8", small).toImageMsg();
+      cv::resize(cv_bridge::toCvShare(st.images[i])->image, small,
+                 cv::Size(half->width, half->height));
+      sensor_msgs::ImagePtr m =
+          cv_bridge::CvImage(st.images[i]->header, "bgr8", small).toImageMsg();
       w.OnImage(m, half, m->header.stamp);
     } else {
       w.OnImage(st.images[i], st.info, st.images[i]->header.stamp);
@@ -845,6 +938,60 @@ TEST(WrapperTest, ReconfigureRequestsApplyOnTheNextFrame) {
   Feed(&w, st, 10, 12);
   EXPECT_EQ(sink.states[9].w_distortion, 200.0);
   EXPECT_EQ(sink.states[10].w_distortion, 7.5);
+}
+
+}  // namespace
+}  // namespace steadiface_ros
+
+namespace steadiface_ros {
+namespace {
+
+// The view (output/crop dynamic, output/horizon level): each frame's state
+// carries its crop and camera_info the matching focal length; the horizon
+// is levelled from the messages' accelerometer, and without one the state
+// says why it is not.
+TEST(WrapperTest, TheViewReachesTheStateAndCameraInfo) {
+  steadiface::PipelineOptions o = Options();
+  o.crop.mode = steadiface::CropMode::kDynamic;
+  o.horizon.mode = steadiface::HorizonMode::kLevel;
+  Sink sink;
+  StabilizerWrapper w(o, WrapperOptions(), &sink);
+  Feed(&w, TestStream());
+  ASSERT_EQ(sink.states.size(), TestStream().images.size());
+  ASSERT_EQ(sink.infos.size(), sink.states.size());
+  const double fx0 =
+      sink.infos.front()->K[0] * (1.0 - 2.0 * sink.states.front().crop_ratio);
+  for (size_t i = 0; i < sink.states.size(); ++i) {
+    const steadiface::StabilizerState& s = sink.states[i];
+    EXPECT_EQ(s.crop_mode, "dynamic");
+    EXPECT_GE(s.crop_ratio, 0.0);
+    EXPECT_LE(s.crop_ratio, 0.15);
+    // fx in output pixels times the kept width is the same on every frame.
+    EXPECT_NEAR(sink.infos[i]->K[0] * (1.0 - 2.0 * s.crop_ratio), fx0,
+                1e-6 * fx0)
+        << i;
+  }
+  const WrapperStatus st = w.Status();
+  EXPECT_EQ(st.horizon_mode, "level");
+  EXPECT_TRUE(st.horizon.active);
+  // The walk's bob (2.6 m/s^2 at 1.8 Hz) puts many readings beyond 10 % of
+  // 1 g: they are left out.
+  EXPECT_GT(st.accel_accepted, 50u);
+  EXPECT_GT(st.accel_rejected, 0u);
+  EXPECT_LT(std::abs(st.horizon.output_roll_rad), 0.02);  // the walk is level
+  ExpectAllFinite(sink);
+
+  // The same without accelerometer readings: the roll is left alone.
+  Sink bare;
+  StabilizerWrapper w2(o, WrapperOptions(), &bare);
+  Feed(&w2, TestStream(), 0, -1, [](sensor_msgs::Imu* m) {
+    m->linear_acceleration.x = m->linear_acceleration.y =
+        m->linear_acceleration.z = 0.0;
+  });
+  EXPECT_FALSE(w2.Status().horizon.active);
+  EXPECT_EQ(w2.Status().horizon.inactive_reason, "no accelerometer");
+  EXPECT_EQ(w2.Status().counters.accel_in, 0u);
+  EXPECT_EQ(bare.states.size(), TestStream().images.size());
 }
 
 }  // namespace

@@ -139,6 +139,12 @@ int main(int argc, char** argv) {
       m.angular_velocity.x = w.x();
       m.angular_velocity.y = w.y();
       m.angular_velocity.z = w.z();
+      if (g < sim->accel().size()) {  // the accelerometer, same axes
+        const Eigen::Vector3d a = R_imu_cam * sim->accel()[g].linear_acceleration;
+        m.linear_acceleration.x = a.x();
+        m.linear_acceleration.y = a.y();
+        m.linear_acceleration.z = a.z();
+      }
       m.orientation_covariance[0] = -1;
       bag.write(imu_topic, m.header.stamp, m);
     }
