@@ -1,20 +1,52 @@
 #include "steadiface_core/view/crop_need.h"
 
+#include <algorithm>
+
 #include "steadiface_core/warp/protrusion.h"
+#include "steadiface_core/warp/warp_geometry.h"
 
 namespace steadiface {
 
 double CropNeed(const CameraModel& model, const OutputGeometry& output,
                 const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
                 const RowRotations& rows, int samples_per_edge, int steps) {
+  // The window's outer pixel centres at r (as ProtrusionGeometry samples
+  // them), each mapped into the real frame through its own row; without
+  // building a ProtrusionGeometry (which copies the camera model).
+  const CameraIntrinsics& k = model.intrinsics();
+  const int n = std::max(2, samples_per_edge);
   auto defined_at = [&](double r) {
-    const ProtrusionGeometry window(model, output.WithCropRatio(r),
-                                    samples_per_edge);
-    return window.Check(R_v, t, rows, 0.0).defined;
+    const OutputGeometry g = output.WithCropRatio(r);
+    const double w1 = g.width() - 1, h1 = g.height() - 1;
+    double row = 0.5 * (k.height - 1);
+    for (int e = 0; e < 4; ++e) {
+      for (int i = 0; i < n; ++i) {
+        const double f = static_cast<double>(i) / n;
+        const Eigen::Vector2d uv = e == 0   ? Eigen::Vector2d(f * w1, 0.0)
+                                   : e == 1 ? Eigen::Vector2d(w1, f * h1)
+                                   : e == 2 ? Eigen::Vector2d(w1 - f * w1, h1)
+                                            : Eigen::Vector2d(0.0, h1 - f * h1);
+        Eigen::Vector2d p;
+        if (!VirtualToRealPixelRS(model, R_v, t, rows,
+                                  g.OutputPixelToVirtual(uv), 6, 1e-3, &p,
+                                  &row) ||
+            ProtrusionGeometry::Outside<double>(p, k.width, k.height, 0.0)
+                    .squaredNorm() > 0.0) {
+          return false;
+        }
+      }
+    }
+    return true;
   };
-  double lo = 0.0, hi = 0.4;  // hi: defined (or the narrowest window)
-  if (!defined_at(hi)) return hi;
-  if (defined_at(lo)) return lo;
+  // Most needs are below 0.2: bisect [0, 0.25], else [0.25, 0.4].
+  double lo = 0.0, hi = 0.25;  // hi: defined
+  if (!defined_at(hi)) {
+    lo = hi;
+    hi = 0.4;
+    if (!defined_at(hi)) return hi;
+  } else if (defined_at(lo)) {
+    return lo;
+  }
   for (int i = 0; i < steps; ++i) {
     const double mid = 0.5 * (lo + hi);
     (defined_at(mid) ? hi : lo) = mid;
