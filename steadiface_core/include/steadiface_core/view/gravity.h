@@ -52,10 +52,12 @@ struct HorizonOptions {
   /// the output as it settles. In [0, 60].
   double warmup_s = 0.3;
   /// Weights of the horizon term E_h (the roll against gravity, squared
-  /// sine) in the solve: `level` and `lock` [-]. The face term's is
-  /// stabilizer weights.fit (100): level yields to it and to the margin.
+  /// sine) in the solve: `level` and `lock` [-]. Both below the face term's
+  /// w_f (stabilizer weights.fit, 100), so where the two conflict the face
+  /// wins; `lock` holds the roll mostly by measuring E_d and E_o against
+  /// the real camera turned level, which leaves the face its term.
   double level_weight = 4.0;
-  double lock_weight = 400.0;
+  double lock_weight = 50.0;
 };
 
 Status ValidateHorizonOptions(const HorizonOptions& options);
