@@ -299,9 +299,11 @@ void Simulator::SynthesizeImu() {
   const SimulatorOptions& o = options_;
   std::mt19937_64 rng(options_.seed * 104729 + 3);
   std::normal_distribution<double> n01(0.0, 1.0);
-  // The accelerometer's noise from its own stream: the gyro's stays what it
-  // was before there was an accelerometer.
+  // The accelerometer's noise from its own engine and distribution (a
+  // normal distribution caches every other draw): the gyro's samples stay
+  // what they were before there was an accelerometer.
   std::mt19937_64 rng_accel(options_.seed * 7919 + 11);
+  std::normal_distribution<double> n01_accel(0.0, 1.0);
   const double t_end = o.duration_s + o.readout_s + 0.06;
   const int n = static_cast<int>(t_end * o.imu_rate_hz) + 1;
   imu_.reserve(n);
@@ -328,8 +330,8 @@ void Simulator::SynthesizeImu() {
         (CameraPose(t + h).p - 2.0 * P.p + CameraPose(t - h).p) / (h * h);
     const Eigen::Vector3d gravity(0.0, kStandardGravity, 0.0);
     const Eigen::Vector3d f = P.R.conjugate() * (acc - gravity) +
-                              o.accel_noise * Eigen::Vector3d(n01(rng_accel), n01(rng_accel),
-                                                              n01(rng_accel));
+                              o.accel_noise * Eigen::Vector3d(n01_accel(rng_accel), n01_accel(rng_accel),
+                                                              n01_accel(rng_accel));
     accel_.push_back({Time(FromSeconds(stamp)), f});
   }
 }
