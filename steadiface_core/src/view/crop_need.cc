@@ -1,7 +1,5 @@
 #include "steadiface_core/view/crop_need.h"
 
-#include <algorithm>
-
 #include "steadiface_core/warp/protrusion.h"
 #include "steadiface_core/warp/warp_geometry.h"
 
@@ -10,30 +8,19 @@ namespace steadiface {
 double CropNeed(const CameraModel& model, const OutputGeometry& output,
                 const Eigen::Quaterniond& R_v, const Eigen::Vector2d& t,
                 const RowRotations& rows, int samples_per_edge, int steps) {
-  // The window's outer pixel centres at r (as ProtrusionGeometry samples
-  // them), each mapped into the real frame through its own row; without
-  // building a ProtrusionGeometry (which copies the camera model).
+  // The window's samples at r (ProtrusionGeometry's), each mapped into the
+  // real frame through its own row; without building a ProtrusionGeometry
+  // (which copies the camera model).
   const CameraIntrinsics& k = model.intrinsics();
-  const int n = std::max(2, samples_per_edge);
   auto defined_at = [&](double r) {
-    const OutputGeometry g = output.WithCropRatio(r);
-    const double w1 = g.width() - 1, h1 = g.height() - 1;
     double row = 0.5 * (k.height - 1);
-    for (int e = 0; e < 4; ++e) {
-      for (int i = 0; i < n; ++i) {
-        const double f = static_cast<double>(i) / n;
-        const Eigen::Vector2d uv = e == 0   ? Eigen::Vector2d(f * w1, 0.0)
-                                   : e == 1 ? Eigen::Vector2d(w1, f * h1)
-                                   : e == 2 ? Eigen::Vector2d(w1 - f * w1, h1)
-                                            : Eigen::Vector2d(0.0, h1 - f * h1);
-        Eigen::Vector2d p;
-        if (!VirtualToRealPixelRS(model, R_v, t, rows,
-                                  g.OutputPixelToVirtual(uv), 6, 1e-3, &p,
-                                  &row) ||
-            ProtrusionGeometry::Outside<double>(p, k.width, k.height, 0.0)
-                    .squaredNorm() > 0.0) {
-          return false;
-        }
+    for (const Eigen::Vector2d& V : ProtrusionGeometry::WindowBoundary(
+             output.WithCropRatio(r), samples_per_edge)) {
+      Eigen::Vector2d p;
+      if (!VirtualToRealPixelRS(model, R_v, t, rows, V, 6, 1e-3, &p, &row) ||
+          ProtrusionGeometry::Outside<double>(p, k.width, k.height, 0.0)
+                  .squaredNorm() > 0.0) {
+        return false;
       }
     }
     return true;

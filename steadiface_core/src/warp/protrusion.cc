@@ -7,26 +7,32 @@ namespace steadiface {
 ProtrusionGeometry::ProtrusionGeometry(const CameraModel& model,
                                        const OutputGeometry& output,
                                        int samples_per_edge)
-    : model_(model) {
+    : model_(model), boundary_(WindowBoundary(output, samples_per_edge)) {}
+
+std::vector<Eigen::Vector2d> ProtrusionGeometry::WindowBoundary(const OutputGeometry& output,
+                                                                int samples_per_edge) {
   const int n = std::max(2, samples_per_edge);
   const double w1 = output.width() - 1, h1 = output.height() - 1;
+  std::vector<Eigen::Vector2d> boundary;
+  boundary.reserve(4 * n);
   // Clockwise around the outer pixel centres, corners once.
   for (int i = 0; i < n; ++i) {
     const double s = static_cast<double>(i) / n;
-    boundary_.push_back(output.OutputPixelToVirtual({s * w1, 0.0}));
+    boundary.push_back(output.OutputPixelToVirtual({s * w1, 0.0}));
   }
   for (int i = 0; i < n; ++i) {
     const double s = static_cast<double>(i) / n;
-    boundary_.push_back(output.OutputPixelToVirtual({w1, s * h1}));
+    boundary.push_back(output.OutputPixelToVirtual({w1, s * h1}));
   }
   for (int i = 0; i < n; ++i) {
     const double s = static_cast<double>(i) / n;
-    boundary_.push_back(output.OutputPixelToVirtual({w1 - s * w1, h1}));
+    boundary.push_back(output.OutputPixelToVirtual({w1 - s * w1, h1}));
   }
   for (int i = 0; i < n; ++i) {
     const double s = static_cast<double>(i) / n;
-    boundary_.push_back(output.OutputPixelToVirtual({0.0, h1 - s * h1}));
+    boundary.push_back(output.OutputPixelToVirtual({0.0, h1 - s * h1}));
   }
+  return boundary;
 }
 
 ProtrusionReport ProtrusionGeometry::Check(const Eigen::Quaterniond& R_v,

@@ -41,6 +41,12 @@ class ProtrusionGeometry {
   ProtrusionGeometry(const CameraModel& model, const OutputGeometry& output,
                      int samples_per_edge);
 
+  /// The outer pixel centres of `output`'s window, clockwise, corners once,
+  /// `samples_per_edge` (at least 2) per edge, in virtual normalized
+  /// coordinates: the samples Check() maps (and CropNeed, per crop).
+  static std::vector<Eigen::Vector2d> WindowBoundary(const OutputGeometry& output,
+                                                     int samples_per_edge);
+
   /// Boundary samples in virtual normalized coordinates.
   const std::vector<Eigen::Vector2d>& boundary() const { return boundary_; }
   size_t num_samples() const { return boundary_.size(); }
