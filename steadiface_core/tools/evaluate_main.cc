@@ -193,6 +193,60 @@ int Usage() {
   return 2;
 }
 
+
+// The view's flags: the crop mode and the horizon, and their tuning
+// (NaN, -1 or empty: the package's default).
+struct ViewFlags {
+  int crop_mode = -1;      // --crop-mode: 0 fixed, 1 dynamic
+  std::string horizon;     // --horizon: off, level or lock
+  double level_weight = NAN, lock_weight = NAN;   // horizon.level_weight, lock_weight
+  double gravity_warmup = NAN, gravity_tau = NAN;  // horizon.warmup, time_constant
+  double widest = NAN;     // output.dynamic.widest_crop_ratio
+  bool start_tight = false;  // output.dynamic.start_wide false
+  double shake_hz = NAN, headroom = NAN;  // output.dynamic.shake_path_hz, headroom
+  // output.dynamic.max_widen_rate, max_tighten_rate, max_widen_accel
+  double widen_rate = NAN, tighten_rate = NAN, zoom_accel = NAN;
+};
+
+void AddViewFlags(steadiface::CommandLine* cl, ViewFlags* v) {
+  cl->Value("--crop-mode", "fixed or dynamic", [v](const std::string& s) {
+    v->crop_mode = s == "dynamic" ? 1 : 0;
+    return s == "fixed" || s == "dynamic";
+  });
+  cl->Value("--horizon", "off, level or lock", [v](const std::string& s) {
+    v->horizon = s;
+    steadiface::HorizonMode m;
+    return steadiface::ParseHorizonMode(s, &m).ok();
+  });
+  cl->Double("--level-weight", &v->level_weight).Double("--lock-weight", &v->lock_weight);
+  cl->Double("--gravity-warmup", &v->gravity_warmup).Double("--gravity-tau", &v->gravity_tau);
+  cl->Double("--widest", &v->widest).Flag("--start-tight", &v->start_tight);
+  cl->Double("--shake-hz", &v->shake_hz).Double("--headroom", &v->headroom);
+  cl->Double("--widen-rate", &v->widen_rate).Double("--tighten-rate", &v->tighten_rate);
+  cl->Double("--zoom-accel", &v->zoom_accel);
+}
+
+void ApplyViewFlags(const ViewFlags& v, steadiface::PipelineOptions* po) {
+  auto set = [](double flag, double* field) {
+    if (std::isfinite(flag)) *field = flag;
+  };
+  if (v.crop_mode >= 0) {
+    po->crop.mode = v.crop_mode == 1 ? steadiface::CropMode::kDynamic : steadiface::CropMode::kFixed;
+  }
+  if (!v.horizon.empty()) steadiface::ParseHorizonMode(v.horizon, &po->horizon.mode);
+  if (v.start_tight) po->crop.start_wide = false;
+  set(v.widest, &po->crop.widest_crop_ratio);
+  set(v.level_weight, &po->horizon.level_weight);
+  set(v.lock_weight, &po->horizon.lock_weight);
+  set(v.gravity_warmup, &po->horizon.warmup_s);
+  set(v.gravity_tau, &po->horizon.time_constant_s);
+  set(v.shake_hz, &po->crop.shake_path_hz);
+  set(v.headroom, &po->crop.headroom);
+  set(v.widen_rate, &po->crop.max_widen_rate);
+  set(v.tighten_rate, &po->crop.max_tighten_rate);
+  set(v.zoom_accel, &po->crop.max_widen_accel);
+}
+
 }  // namespace
 
 // --average15 N: writes each method's output frame N (<prefix>_frame.png)
@@ -277,15 +331,7 @@ int main(int argc, char** argv) {
   double search_interval = NAN;  // face.search_interval [s]; NaN: the default
   double head_distance = NAN;    // the subject's distance [m]; NaN: the preset's
   bool visual_rotation = false;  // --rotation-source visual
-  int crop_mode = -1;            // --crop-mode: 0 fixed, 1 dynamic; -1: the default
-  std::string horizon;           // --horizon: off, level or lock; empty: the default
-  // horizon.level_weight, lock_weight, warmup, time_constant (NaN: default)
-  double level_weight = NAN, lock_weight = NAN, gravity_warmup = NAN, gravity_tau = NAN;
-  double widest = NAN;           // --widest: output.dynamic.widest_crop_ratio
-  bool start_tight = false;      // --start-tight: output.dynamic.start_wide false
-  double shake_hz = NAN, headroom = NAN;  // output.dynamic.shake_path_hz, headroom
-  // output.dynamic.max_widen_rate, max_tighten_rate, max_accel (NaN: default)
-  double widen_rate = NAN, tighten_rate = NAN, zoom_accel = NAN;
+  ViewFlags view;                // --crop-mode, --horizon and their tuning
   double head_w_stay = NAN;      // head.w_stay [-]; NaN: the default
   double head_d_ref = NAN;       // head.d_ref [fraction of the width]; NaN: the default
   double subject_reach = 0.0;    // stabilizer.subject_reach [jaw widths]; 0: off
@@ -311,21 +357,7 @@ int main(int argc, char** argv) {
     visual_rotation = v == "visual";
     return v == "imu" || v == "visual";
   });
-  cl.Value("--crop-mode", "fixed or dynamic", [&](const std::string& v) {
-    crop_mode = v == "dynamic" ? 1 : 0;
-    return v == "fixed" || v == "dynamic";
-  });
-  cl.Value("--horizon", "off, level or lock", [&](const std::string& v) {
-    horizon = v;
-    steadiface::HorizonMode m;
-    return steadiface::ParseHorizonMode(v, &m).ok();
-  });
-  cl.Double("--level-weight", &level_weight).Double("--lock-weight", &lock_weight);
-  cl.Double("--gravity-warmup", &gravity_warmup).Double("--gravity-tau", &gravity_tau);
-  cl.Double("--widest", &widest).Flag("--start-tight", &start_tight);
-  cl.Double("--shake-hz", &shake_hz).Double("--headroom", &headroom);
-  cl.Double("--widen-rate", &widen_rate).Double("--tighten-rate", &tighten_rate);
-  cl.Double("--zoom-accel", &zoom_accel);
+  AddViewFlags(&cl, &view);
   cl.Double("--head-w-stay", &head_w_stay).Double("--head-d-ref", &head_d_ref);
   cl.Double("--subject-reach", &subject_reach).Double("--reach-lowpass", &reach_lowpass);
   cl.Double("--reach-hold", &reach_hold).Flag("--feasible-set", &feasible_set);
@@ -508,21 +540,7 @@ int main(int argc, char** argv) {
                                                         : Method::kSteadiface;
         steadiface::PipelineOptions po = steadiface::eval::OptionsFor(*sim, m);
         if (std::isfinite(crop)) po.warp.output.crop_ratio = crop;
-        if (crop_mode >= 0) {
-          po.crop.mode = crop_mode == 1 ? steadiface::CropMode::kDynamic : steadiface::CropMode::kFixed;
-        }
-        if (std::isfinite(widest)) po.crop.widest_crop_ratio = widest;
-        if (!horizon.empty()) steadiface::ParseHorizonMode(horizon, &po.horizon.mode);
-        if (std::isfinite(level_weight)) po.horizon.level_weight = level_weight;
-        if (std::isfinite(lock_weight)) po.horizon.lock_weight = lock_weight;
-        if (std::isfinite(gravity_warmup)) po.horizon.warmup_s = gravity_warmup;
-        if (std::isfinite(gravity_tau)) po.horizon.time_constant_s = gravity_tau;
-        if (start_tight) po.crop.start_wide = false;
-        if (std::isfinite(shake_hz)) po.crop.shake_path_hz = shake_hz;
-        if (std::isfinite(headroom)) po.crop.headroom = headroom;
-        if (std::isfinite(widen_rate)) po.crop.max_widen_rate = widen_rate;
-        if (std::isfinite(tighten_rate)) po.crop.max_tighten_rate = tighten_rate;
-        if (std::isfinite(zoom_accel)) po.crop.max_widen_accel = zoom_accel;
+        ApplyViewFlags(view, &po);
         if (std::isfinite(search_interval)) po.face.search_interval_s = search_interval;
         if (visual_rotation) po.rotation_source = steadiface::RotationSource::kVisual;
         if (std::isfinite(head_w_stay)) po.stabilizer.head.w_stay = head_w_stay;
