@@ -12,8 +12,8 @@
 #include "steadiface_core/composite/compositor.h"
 #include "steadiface_core/composite/guided_filter.h"
 #include "steadiface_core/composite/layer_homography.h"
-#include "steadiface_core/warp/debug_overlay.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/pipeline/debug_overlay.h"
+#include "steadiface_core/camera/output_geometry.h"
 #include "steadiface_core/warp/warper.h"
 #include "test_util.h"
 

@@ -1,4 +1,4 @@
-#include "steadiface_core/warp/debug_overlay.h"
+#include "steadiface_core/pipeline/debug_overlay.h"
 
 #include <memory>
 

@@ -12,7 +12,7 @@
 #include "steadiface_core/view/crop_need.h"
 #include "steadiface_core/view/dynamic_crop.h"
 #include "steadiface_core/view/shake_path.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 #include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {

@@ -4,7 +4,7 @@
 
 #include <sensor_msgs/image_encodings.h>
 
-#include "steadiface_core/warp/debug_overlay.h"
+#include "steadiface_core/pipeline/debug_overlay.h"
 #include "steadiface_ros/msg_conversion.h"
 #include "steadiface_ros/time_conversion.h"
 

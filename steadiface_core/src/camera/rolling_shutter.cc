@@ -42,10 +42,4 @@ Time RowTiming::RowTime(Time stamp, double y) const {
   return stamp + FromSeconds(offset_s);
 }
 
-QueryResult RealRotationAtRow(const OrientationTimeline& timeline,
-                              const RowTiming& timing, Time stamp, double y,
-                              Eigen::Quaterniond* R_r) {
-  return timeline.RealRotation(timing.RowTime(stamp, y), R_r);
-}
-
 }  // namespace steadiface

@@ -50,4 +50,10 @@ Eigen::Quaterniond RowRotations::At(double y) const {
   return table_[i].slerp(s - static_cast<double>(i), table_[i + 1]);
 }
 
+QueryResult RealRotationAtRow(const OrientationTimeline& timeline,
+                              const RowTiming& timing, Time stamp, double y,
+                              Eigen::Quaterniond* R_r) {
+  return timeline.RealRotation(timing.RowTime(stamp, y), R_r);
+}
+
 }  // namespace steadiface

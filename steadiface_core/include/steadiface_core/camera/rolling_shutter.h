@@ -1,10 +1,7 @@
 #pragma once
 
-#include <Eigen/Geometry>
-
 #include "steadiface_core/common/status.h"
 #include "steadiface_core/common/time.h"
-#include "steadiface_core/gyro/orientation_timeline.h"
 
 namespace steadiface {
 
@@ -54,11 +51,5 @@ class RowTiming {
   RollingShutterOptions options_;
   int height_;
 };
-
-/// R_r(y): the paper's real rotation (world -> camera) for row y of the frame
-/// stamped `stamp`.
-QueryResult RealRotationAtRow(const OrientationTimeline& timeline,
-                              const RowTiming& timing, Time stamp, double y,
-                              Eigen::Quaterniond* R_r);
 
 }  // namespace steadiface

@@ -6,7 +6,7 @@
 
 #include "steadiface_core/common/status.h"
 #include "steadiface_core/composite/layer_homography.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 
 namespace steadiface {
 

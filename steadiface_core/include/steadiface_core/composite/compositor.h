@@ -11,7 +11,7 @@
 #include "steadiface_core/composite/layer_homography.h"
 #include "steadiface_core/composite/subject_matte.h"
 #include "steadiface_core/layered/subject_region.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 
 namespace steadiface {
 

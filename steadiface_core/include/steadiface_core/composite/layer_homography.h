@@ -5,7 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include "steadiface_core/camera/camera_intrinsics.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 
 namespace steadiface {
 

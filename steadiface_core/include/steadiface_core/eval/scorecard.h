@@ -10,7 +10,7 @@
 #include "steadiface_core/camera/camera_model.h"
 #include "steadiface_core/gyro/row_rotations.h"
 #include "steadiface_core/sim/simulator.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 #include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {

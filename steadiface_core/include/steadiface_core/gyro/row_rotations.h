@@ -46,4 +46,10 @@ class RowRotations {
   std::vector<Eigen::Quaterniond> table_;
 };
 
+/// R_r(y): the paper's real rotation (world -> camera) for row y of the frame
+/// stamped `stamp`.
+QueryResult RealRotationAtRow(const OrientationTimeline& timeline,
+                              const RowTiming& timing, Time stamp, double y,
+                              Eigen::Quaterniond* R_r);
+
 }  // namespace steadiface

@@ -10,7 +10,7 @@
 #include "steadiface_core/common/status.h"
 #include "steadiface_core/face/face_observation.h"
 #include "steadiface_core/gyro/row_rotations.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 
 namespace steadiface {
 

@@ -17,7 +17,7 @@
 #include "steadiface_core/stabilizer/dynamic_weights.h"
 #include "steadiface_core/stabilizer/head_smoother.h"
 #include "steadiface_core/stabilizer/stabilizer_options.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 #include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {

@@ -13,7 +13,7 @@
 #include "steadiface_core/gyro/row_rotations.h"
 #include "steadiface_core/layered/layer_blend.h"
 #include "steadiface_core/layered/subject_region.h"
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 #include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {

@@ -1,4 +1,4 @@
-#include "steadiface_core/warp/output_geometry.h"
+#include "steadiface_core/camera/output_geometry.h"
 
 #include <algorithm>
 #include <cmath>
