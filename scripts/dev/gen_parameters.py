@@ -9,6 +9,9 @@ unit, meaning and dynamic_reconfigure name):
   description, default, range), built into SteadifaceConfig;
 - steadiface_ros/src/parameter_table.inc: the C++ table LoadOptions checks
   ranges and choices against (and params_test checks its keys against);
+- steadiface_ros/src/parameter_fields.inc: LoadOptions' readers (one per
+  section: each key read into the option field its `field:` names) and the
+  dynamic_reconfigure mapping both ways (ApplyConfig, ConfigFromOptions);
 - docs/parameters.md: the reference.
 
 usage: gen_parameters.py [--check]
@@ -17,6 +20,7 @@ usage: gen_parameters.py [--check]
 """
 import os
 import sys
+import re
 import textwrap
 
 import yaml
@@ -27,6 +31,7 @@ OUTPUTS = {
     "default_yaml": os.path.join(REPO, "config", "default.yaml"),
     "cfg": os.path.join(REPO, "config", "Steadiface.cfg"),
     "inc": os.path.join(REPO, "steadiface_ros", "src", "parameter_table.inc"),
+    "fields": os.path.join(REPO, "steadiface_ros", "src", "parameter_fields.inc"),
     "doc": os.path.join(REPO, "docs", "parameters.md"),
 }
 TYPES = {"double", "int", "bool", "string", "list"}
@@ -54,7 +59,31 @@ def load_table(path=TABLE):
                 raise SystemExit("parameters.yaml: %s: default %r is not a choice" % (key, e["default"]))
             if e["type"] in ("double", "int") and "min" not in e:
                 raise SystemExit("parameters.yaml: %s: a number needs min and max" % key)
+            check_field(e)
     return sections
+
+
+FIELD = re.compile(r"^(pipeline|wrapper)(\.[a-z_][a-z_0-9]*)+$")
+
+
+def check_field(e):
+    """A key read by the node names the option it sets: `field:` is
+    pipeline.<path> (steadiface::PipelineOptions) or wrapper.<path>
+    (WrapperOptions), or custom (read by hand in params.cc)."""
+    key, field = e["key"], e.get("field")
+    if e.get("read_by") == "launch":
+        if field is not None:
+            raise SystemExit("parameters.yaml: %s: the node does not read it, so no field" % key)
+        return
+    if field is None or (field != "custom" and not FIELD.match(field)):
+        raise SystemExit("parameters.yaml: %s: field must be pipeline.<path>, wrapper.<path> "
+                         "or custom, got %r" % (key, field))
+    if "dynamic" in e and field == "custom":
+        raise SystemExit("parameters.yaml: %s: a run-time key needs its field" % key)
+    if "enum" in e and len(e["enum"]["values"]) != len(e.get("choices", [])):
+        raise SystemExit("parameters.yaml: %s: one enum value per choice" % key)
+    if e.get("read") not in (None, "path") or (e.get("read") and e["type"] != "string"):
+        raise SystemExit("parameters.yaml: %s: read: path is for strings" % key)
 
 
 def fmt(v):
@@ -185,6 +214,138 @@ def cnum(v):
     return r if ("e" in r or "." in r or "inf" in r) else r + ".0"
 
 
+# ---- steadiface_ros/src/parameter_fields.inc ---------------------------------
+
+def c_path(field):
+    """pipeline.a.b -> pipeline->a.b (the pointer the generated code gets)."""
+    root, _, rest = field.partition(".")
+    return "%s->%s" % (root, rest)
+
+
+def camel(title):
+    """A section title's words before any '(', ';' or ':', in CamelCase."""
+    words = re.split(r"[^A-Za-z0-9]+", re.split(r"[(;:]", title)[0])
+    return "".join(w[0].upper() + w[1:].lower() for w in words if w)
+
+
+def enum_names_fn(e):
+    return "%sNames" % camel(e["key"].replace("/", " ").replace("_", " "))
+
+
+def enum_names(e):
+    """A function returning a key's choice <-> enum value list."""
+    t = e["enum"]["type"]
+    pairs = ['      {"%s", %s::%s},' % (c, t, v) for c, v in zip(e["choices"], e["enum"]["values"])]
+    return (["const EnumNames<%s>& %s() {" % (t, enum_names_fn(e)),
+             "  static const EnumNames<%s> names = {" % t] + pairs +
+            ["  };", "  return names;", "}"])
+
+
+def read_line(e):
+    key, dest = e["key"], "&" + c_path(e["field"])
+    if "enum" in e:
+        return '  r.Enum("%s", %s, %s());' % (key, dest, enum_names_fn(e))
+    if e.get("read") == "path":
+        return '  r.Path("%s", %s);' % (key, dest)
+    if e["type"] == "string":
+        return '  r.%s("%s", %s);' % ("Choice" if e.get("choices") else "Str", key, dest)
+    return '  r.%s("%s", %s);' % ({"double": "Num", "int": "Int", "bool": "Bool", "list": "Vec"}[
+        e["type"]], key, dest)
+
+
+def section_reader(sec):
+    """Reads the section's keys that have a field; None if it has none."""
+    entries = [e for e in sec["keys"] if e.get("field") not in (None, "custom")]
+    if not entries:
+        return None, []
+    roots = {e["field"].split(".")[0] for e in entries}
+    args = ", ".join("%s%s" % (t, n if n in roots else "/*%s*/" % n) for t, n in (
+        ("steadiface::PipelineOptions* ", "pipeline"), ("WrapperOptions* ", "wrapper")))
+    name = "Read%s" % camel(sec["section"])
+    return name, ["// %s" % sec["section"], "void %s(Reader& r, %s) {" % (name, args)] + [
+        read_line(e) for e in entries] + ["}"]
+
+
+def dynamic_groups(sections):
+    groups = []  # [(group, [entry])] in order of first appearance
+    for sec in sections:
+        for e in sec["keys"]:
+            if "dynamic" in e:
+                g = e["dynamic"]["group"]
+                if not any(name == g for name, _ in groups):
+                    groups.append((g, []))
+                next(lst for name, lst in groups if name == g).append(e)
+    return groups
+
+
+def apply_line(e, by_key):
+    d, dest = e["dynamic"], c_path(e["field"])
+    if "enum" in e:
+        return "  FromName(c.%s, %s(), &%s);" % (d["name"], enum_names_fn(e), dest)
+    if "above" in d:  # dynamic_reconfigure sets keys one by one: keep low < high
+        low = by_key[d["above"]]["dynamic"]["name"]
+        return "  %s = std::max(c.%s, c.%s + %s);" % (dest, d["name"], low, d["by"])
+    return "  %s = c.%s;" % (dest, d["name"])
+
+
+def config_line(e):
+    d, src = e["dynamic"], e["field"].replace("pipeline.", "pipeline.", 1)
+    if "enum" in e:
+        return "  c->%s = NameOf(%s, %s());" % (d["name"], src, enum_names_fn(e))
+    return "  c->%s = %s;" % (d["name"], src)
+
+
+def reconfigure(sections):
+    by_key = {e["key"]: e for sec in sections for e in sec["keys"]}
+    out, applies, configs = [], [], []
+    for g, entries in dynamic_groups(sections):
+        if any(e["field"].split(".")[0] != "pipeline" for e in entries):
+            raise SystemExit("parameters.yaml: run-time keys must set pipeline options (%s)" % g)
+        a, f = "Apply%s" % camel(g), "Config%s" % camel(g)
+        out += ["void %s(const steadiface::SteadifaceConfig& c, "
+                "steadiface::PipelineOptions* pipeline) {" % a]
+        out += [apply_line(e, by_key) for e in entries] + ["}", ""]
+        out += ["void %s(const steadiface::PipelineOptions& pipeline, "
+                "steadiface::SteadifaceConfig* c) {" % f]
+        out += [config_line(e) for e in entries] + ["}", ""]
+        applies.append("  %s(config, pipeline);" % a)
+        configs.append("  %s(pipeline, &c);" % f)
+    return out, applies, configs
+
+
+def fields(sections):
+    out = ["// " + GENERATED,
+           "// Included by params.cc after its Reader: LoadOptions' readers, one per section",
+           "// of the table (each key into the option field its row names), and the",
+           "// dynamic_reconfigure mapping both ways. Keys with field: custom are read by",
+           "// hand in params.cc.", "", "namespace {", ""]
+    for sec in sections:
+        for e in sec["keys"]:
+            if "enum" in e:
+                out += enum_names(e) + [""]
+    readers = []
+    for sec in sections:
+        name, lines = section_reader(sec)
+        if name:
+            out += lines + [""]
+            readers.append(name)
+    out += ["// Every key with a field, in the table's order.",
+            "void ReadTable(Reader& r, steadiface::PipelineOptions* pipeline, "
+            "WrapperOptions* wrapper) {"]
+    out += ["  %s(r, %s);" % (n, "pipeline, wrapper") for n in readers] + ["}", ""]
+    body, applies, configs = reconfigure(sections)
+    out += body + ["}  // namespace", "",
+                   "void ApplyConfig(const steadiface::SteadifaceConfig& config,",
+                   "                 steadiface::PipelineOptions* pipeline) {"]
+    out += applies + ["}", "",
+                      "steadiface::SteadifaceConfig ConfigFromOptions(",
+                      "    const steadiface::PipelineOptions& pipeline) {",
+                      "  steadiface::SteadifaceConfig c = "
+                      "steadiface::SteadifaceConfig::__getDefault__();"]
+    out += configs + ["  return c;", "}"]
+    return "\n".join(out) + "\n"
+
+
 # ---- docs/parameters.md ------------------------------------------------------
 
 def doc(sections):
@@ -228,7 +389,7 @@ def doc(sections):
 
 def render_all(sections):
     return {"default_yaml": default_yaml(sections), "cfg": cfg(sections), "inc": inc(sections),
-            "doc": doc(sections)}
+            "fields": fields(sections), "doc": doc(sections)}
 
 
 def main():

@@ -75,7 +75,7 @@ void StabilizerRos::StartReconfigure() {
       new dynamic_reconfigure::Server<steadiface::SteadifaceConfig>(reconfigure_mutex_, pnh_));
   {
     boost::recursive_mutex::scoped_lock lock(reconfigure_mutex_);
-    reconfigure_->updateConfig(ConfigFromOptions(pipeline_options_.stabilizer, pipeline_options_.warp));
+    reconfigure_->updateConfig(ConfigFromOptions(pipeline_options_));
   }
   reconfigure_->setCallback(
       [this](steadiface::SteadifaceConfig& c, uint32_t level) { OnReconfigure(c, level); });
@@ -227,13 +227,10 @@ void StabilizerRos::OnTimer(const ros::TimerEvent&) {
 
 void StabilizerRos::OnReconfigure(steadiface::SteadifaceConfig& config, uint32_t) {
   // Only assigns: the wrapper applies it on the next frame.
-  steadiface::StabilizerOptions o = wrapper_->pipeline_options().stabilizer;
+  steadiface::PipelineOptions o = wrapper_->pipeline_options();
   ApplyConfig(config, &o);
-  wrapper_->RequestStabilizerOptions(o);
-  steadiface::WarpMode mode = wrapper_->pipeline_options().warp.mode;
-  steadiface::LayeredWarpOptions layered = wrapper_->pipeline_options().warp.layered;
-  ApplyConfig(config, &mode, &layered);
-  wrapper_->RequestLayering(mode, layered);
+  wrapper_->RequestStabilizerOptions(o.stabilizer);
+  wrapper_->RequestLayering(o.warp.mode, o.warp.layered);
 }
 
 bool StabilizerRos::LookupExtrinsic(const std::string& imu_frame,

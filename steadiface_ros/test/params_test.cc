@@ -133,8 +133,7 @@ TEST(ParamsTest, FileParametersResolvePackageUrls) {
 TEST(ParamsTest, ReconfigureDefaultsAreTheCoreDefaults) {
   dynamic_reconfigure::Config from_cfg, from_core;
   steadiface::SteadifaceConfig::__getDefault__().__toMessage__(from_cfg);
-  ConfigFromOptions(steadiface::StabilizerOptions(), steadiface::WarpOptions())
-      .__toMessage__(from_core);
+  ConfigFromOptions(steadiface::PipelineOptions()).__toMessage__(from_core);
   ASSERT_EQ(from_cfg.doubles.size(), from_core.doubles.size());
   ASSERT_GT(from_cfg.doubles.size(), 10u);
   for (size_t i = 0; i < from_cfg.doubles.size(); ++i) {
@@ -161,15 +160,30 @@ TEST(ParamsTest, ReconfigureSwitchesTheWarpMode) {
   c.warp_mode = "layered";
   c.band_width = 0.8;
   c.torso = false;
-  steadiface::WarpMode mode = steadiface::WarpMode::kGlobal;
-  steadiface::LayeredWarpOptions layered;
-  ApplyConfig(c, &mode, &layered);
-  EXPECT_EQ(mode, steadiface::WarpMode::kLayered);
-  EXPECT_DOUBLE_EQ(layered.blend.band_width, 0.8);
-  EXPECT_FALSE(layered.region.torso);
+  steadiface::PipelineOptions o;
+  o.warp.mode = steadiface::WarpMode::kGlobal;
+  ApplyConfig(c, &o);
+  EXPECT_EQ(o.warp.mode, steadiface::WarpMode::kLayered);
+  EXPECT_DOUBLE_EQ(o.warp.layered.blend.band_width, 0.8);
+  EXPECT_FALSE(o.warp.layered.region.torso);
   c.warp_mode = "sideways";  // not a mode: left as it was
-  ApplyConfig(c, &mode, &layered);
-  EXPECT_EQ(mode, steadiface::WarpMode::kLayered);
+  ApplyConfig(c, &o);
+  EXPECT_EQ(o.warp.mode, steadiface::WarpMode::kLayered);
+}
+
+// Reconfigure sets keys one at a time: a low threshold raised past its high
+// one lifts the high one just above it, so the options stay valid.
+TEST(ParamsTest, ReconfigureKeepsEachLowBelowItsHigh) {
+  steadiface::SteadifaceConfig c = steadiface::SteadifaceConfig::__getDefault__();
+  c.gyro_still = 0.5;
+  c.gyro_active = 0.2;
+  c.pose_low = 0.4;
+  c.pose_high = 0.1;
+  steadiface::PipelineOptions o;
+  ApplyConfig(c, &o);
+  EXPECT_DOUBLE_EQ(o.stabilizer.dynamic.gyro_active_rad_s, 0.5 + 1e-4);
+  EXPECT_DOUBLE_EQ(o.stabilizer.dynamic.pose_high_rad, 0.4 + 1e-3);
+  EXPECT_TRUE(steadiface::ValidatePipelineOptions(o).ok());
 }
 
 // Reads through another source and records every key asked for.
@@ -248,12 +262,10 @@ TEST(ParamsTest, EveryReconfigureParameterReachesTheOptionsAndBack) {
   for (auto& s : msg.strs) s.value = s.value == "global" ? "layered" : "global";
   steadiface::SteadifaceConfig c = steadiface::SteadifaceConfig::__getDefault__();
   ASSERT_TRUE(c.__fromMessage__(msg));
-  steadiface::StabilizerOptions o;
-  steadiface::WarpOptions w;
+  steadiface::PipelineOptions o;
   ApplyConfig(c, &o);
-  ApplyConfig(c, &w.mode, &w.layered);
   dynamic_reconfigure::Config back;
-  ConfigFromOptions(o, w).__toMessage__(back);
+  ConfigFromOptions(o).__toMessage__(back);
   ASSERT_EQ(back.doubles.size(), msg.doubles.size());
   for (size_t i = 0; i < msg.doubles.size(); ++i) {
     EXPECT_DOUBLE_EQ(back.doubles[i].value, msg.doubles[i].value) << msg.doubles[i].name;

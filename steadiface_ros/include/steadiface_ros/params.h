@@ -92,13 +92,12 @@ steadiface::Status LoadOptions(const ParamSource& params,
                                steadiface::PipelineOptions* pipeline,
                                WrapperOptions* wrapper);
 
-/// dynamic_reconfigure <-> stabilizer options, and the warp mode with the
-/// layered warp's band options.
+/// dynamic_reconfigure <-> the options it changes at run time (the
+/// stabilizer's weights and terms, the warp mode, the layered warp's band and
+/// region). Both are generated from config/parameters.yaml (each run-time
+/// key's field). ApplyConfig keeps each low threshold below its high one.
 void ApplyConfig(const steadiface::SteadifaceConfig& config,
-                 steadiface::StabilizerOptions* options);
-void ApplyConfig(const steadiface::SteadifaceConfig& config, steadiface::WarpMode* mode,
-                 steadiface::LayeredWarpOptions* layered);
-steadiface::SteadifaceConfig ConfigFromOptions(
-    const steadiface::StabilizerOptions& options, const steadiface::WarpOptions& warp);
+                 steadiface::PipelineOptions* pipeline);
+steadiface::SteadifaceConfig ConfigFromOptions(const steadiface::PipelineOptions& pipeline);
 
 }  // namespace steadiface_ros
