@@ -1,12 +1,17 @@
 #!/usr/bin/env python3
-"""Lengths of the C++ functions in steadiface_core/src and steadiface_ros/src.
+"""Lengths of the functions in the package: C++ (.cc and .h: libraries,
+tools, benchmarks, tests and their helpers) and Python (.py, and scripts
+whose first line names python).
 
-A function is a brace block opened right after a parameter list (optionally
+A C++ function is a brace block opened right after a parameter list (optionally
 followed by const, override, noexcept, a trailing return type or a
 constructor's initializer list) outside any other function; its length is
 the number of lines from the line of its opening brace to that of its closing
 brace. Comments, string and character literals are blanked first, so braces
 in them do not count. Lambdas and control blocks belong to their function.
+A Python function (def, at any depth) runs from its def line to its last
+line; a nested def counts within its parent too. Build, devel and install
+spaces and .git are skipped.
 
 usage: function_lengths.py [--max N] [--allow FILE] [--write-allow FILE] [ROOT]
   Prints every function longer than N lines (default 80), longest first.
@@ -15,11 +20,12 @@ usage: function_lengths.py [--max N] [--allow FILE] [--write-allow FILE] [ROOT]
   N (a ratchet: split functions leave the list, none may join or grow).
   --write-allow FILE: writes the current list in FILE's format.
 """
+import ast
 import os
 import re
 import sys
 
-SOURCE_DIRS = ("steadiface_core/src", "steadiface_ros/src")
+SKIP_DIRS = re.compile(r"^(\.git|build.*|devel.*|install.*|out|data|__pycache__|node_modules)$")
 SIGNATURE = re.compile(
     r"([A-Za-z_~][A-Za-z_0-9]*(?:::[A-Za-z_~][A-Za-z_0-9]*)*)\s*"
     r"\((?:[^(){};]|\((?:[^()]|\([^()]*\))*\))*\)\s*"
@@ -27,6 +33,7 @@ SIGNATURE = re.compile(
     r"(?::[^{;]*)?$",
     re.S,
 )
+TEST_MACROS = {"TEST", "TEST_F", "TEST_P", "BENCHMARK_F"}
 NOT_FUNCTIONS = {"if", "for", "while", "switch", "catch", "return", "sizeof", "decltype"}
 
 
@@ -78,6 +85,9 @@ def functions(text):
                 m = SIGNATURE.search(s[max(0, i - 3000):i])
                 if m and m.group(1).split("::")[-1] not in NOT_FUNCTIONS:
                     name = m.group(1)
+                    if name in TEST_MACROS:  # TEST(Suite, Name): the test's name
+                        args = re.match(r"\w+\s*\(([^)]*)\)", m.group(0))
+                        name = ".".join(a.strip() for a in args.group(1).split(","))
             stack.append((name is not None, line, name))
         elif c == "}" and stack:
             is_function, first, name = stack.pop()
@@ -86,20 +96,52 @@ def functions(text):
     return found
 
 
+def python_functions(text):
+    """[(name, first_line, last_line, lines)] of the defs in Python `text`."""
+    found = []
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            found.append((node.name, node.lineno, node.end_lineno,
+                          node.end_lineno - node.lineno + 1))
+    return found
+
+
+def is_python(path):
+    if path.endswith(".py"):
+        return True
+    if os.path.splitext(path)[1]:
+        return False
+    try:
+        with open(path, "rb") as fh:
+            first = fh.readline(200)
+    except OSError:
+        return False
+    return first.startswith(b"#!") and b"python" in first
+
+
+def source_files(root):
+    """(path, kind) of every C++ and Python file under root."""
+    for dirpath, dirs, files in os.walk(root):
+        dirs[:] = sorted(d for d in dirs if not SKIP_DIRS.match(d))
+        for f in sorted(files):
+            path = os.path.join(dirpath, f)
+            if f.endswith((".cc", ".h", ".cpp", ".hpp")):
+                yield path, "c++"
+            elif is_python(path):
+                yield path, "python"
+
+
 def long_functions(root, limit):
     """{(path, name): lines} of the functions longer than `limit` lines."""
     result = {}
-    for d in SOURCE_DIRS:
-        for dirpath, _, files in os.walk(os.path.join(root, d)):
-            for f in sorted(files):
-                if not f.endswith(".cc"):
-                    continue
-                path = os.path.join(dirpath, f)
-                with open(path, encoding="utf-8") as fh:
-                    for name, _, _, n in functions(fh.read()):
-                        if n > limit:
-                            key = (os.path.relpath(path, root), name)
-                            result[key] = max(n, result.get(key, 0))
+    for path, kind in source_files(root):
+        with open(path, encoding="utf-8") as fh:
+            text = fh.read()
+        found = functions(text) if kind == "c++" else python_functions(text)
+        for name, _, _, n in found:
+            if n > limit:
+                key = (os.path.relpath(path, root), name)
+                result[key] = max(n, result.get(key, 0))
     return result
 
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""No function in steadiface_core/src or steadiface_ros/src is longer than
-80 lines, except those listed in scripts/dev/function_length_allowlist.txt,
-which may not grow and leave the list once split (a ratchet). The line
-counter is checked first on C++ text whose function lengths are known.
+"""No function in the package's C++ or Python (libraries, tools,
+benchmarks, tests and their helpers, scripts) is longer than 80 lines,
+except those listed in scripts/dev/function_length_allowlist.txt, which may
+not grow and leave the list once split (a ratchet). The line counter is
+checked first on C++ and Python text whose function lengths are known.
 
 usage: function_length_test.py [--junit FILE]
 """
@@ -56,6 +57,13 @@ class FunctionLengthTest(unittest.TestCase):
         # are; the lambda, the if and the for belong to it.
         self.assertEqual(found, {"Short": 5, "Klass::Method": 21, "Klass::Klass": 7, "Get": 1})
 
+    def test_counts_python_functions_and_names_gtest_cases(self):
+        py = "def f(x):\n" + "    x += 1\n" * 5 + "\n\ndef g():\n    def h():\n        pass\n    return h\n"
+        found = {name: n for name, _, _, n in fl.python_functions(py)}
+        self.assertEqual(found, {"f": 6, "g": 4, "h": 2})
+        cc = "TEST(Suite, Name) {\n" + body(4) + "}\n"
+        self.assertEqual([(n, k) for n, _, _, k in fl.functions(cc)], [("Suite.Name", 4)])
+
     def test_ratchet_rejects_new_grown_and_stale_entries(self):
         found = {("a.cc", "F"): 90, ("a.cc", "G"): 100}
         self.assertEqual(fl.ratchet_errors(found, {("a.cc", "F"): 90, ("a.cc", "G"): 100}, 80), [])
@@ -70,8 +78,17 @@ class FunctionLengthTest(unittest.TestCase):
             os.makedirs(src)
             with open(os.path.join(src, "x.cc"), "w") as fh:
                 fh.write("void Long() {\n" + body(81) + "}\nvoid Fine() {\n" + body(80) + "}\n")
+            tools = os.path.join(root, "scripts", "dev")
+            os.makedirs(tools)
+            with open(os.path.join(tools, "tool"), "w") as fh:  # a script without .py
+                fh.write("#!/usr/bin/env python3\ndef main():\n" + "    pass\n" * 80)
+            build = os.path.join(root, "build", "gen")
+            os.makedirs(build)
+            with open(os.path.join(build, "y.cc"), "w") as fh:  # skipped
+                fh.write("void Generated() {\n" + body(90) + "}\n")
             found = fl.long_functions(root, 80)
-            self.assertEqual(found, {("steadiface_core/src/x.cc", "Long"): 81})
+            self.assertEqual(found, {("steadiface_core/src/x.cc", "Long"): 81,
+                                     (os.path.join("scripts", "dev", "tool"), "main"): 81})
 
     def test_repository_keeps_to_the_allowlist(self):
         found = fl.long_functions(REPO, 80)
