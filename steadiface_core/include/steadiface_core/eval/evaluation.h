@@ -1,0 +1,106 @@
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "steadiface_core/composite/compositor.h"
+#include "steadiface_core/layered/layer_blend.h"
+#include "steadiface_core/pipeline/pipeline.h"
+
+namespace steadiface {
+namespace eval {
+
+/// The view's settings an evaluation overrides (NaN, -1 or empty: the
+/// package's default).
+struct ViewOverrides {
+  /// output.crop: -1 the default, 0 fixed, 1 dynamic.
+  int crop_mode = -1;
+  /// output.horizon: off, level or lock; empty: the default.
+  std::string horizon;
+  /// horizon.level_weight, horizon.lock_weight [-].
+  double level_weight = NAN, lock_weight = NAN;
+  /// horizon.warmup, horizon.time_constant [s].
+  double gravity_warmup_s = NAN, gravity_tau_s = NAN;
+  /// output.dynamic.widest_crop_ratio [-].
+  double widest = NAN;
+  /// output.dynamic.start_wide false.
+  bool start_tight = false;
+  /// output.dynamic.shake_path_hz [Hz], output.dynamic.headroom [-].
+  double shake_hz = NAN, headroom = NAN;
+  /// output.dynamic.max_widen_rate, max_tighten_rate [1/s] and
+  /// max_widen_accel [1/s^2].
+  double widen_rate = NAN, tighten_rate = NAN, zoom_accel = NAN;
+};
+
+/// Everything steadiface_evaluate runs: which presets and methods, the
+/// simulated sequence, the options it changes from each method's defaults
+/// (NaN: the default) and the extra files it writes.
+struct EvaluationOptions {
+  /// The simulator's photos and gyro logs (test/data).
+  std::string data_dir;
+  /// Where report.json, the trajectories and the extra files go.
+  std::string out_dir;
+  /// Simulator presets, in order; default: every one.
+  std::vector<std::string> presets;
+  /// Methods (MethodFromName's names, "<method>/video" for the approximate
+  /// video scorer, ffmpeg-vidstab, ffmpeg-deshake); empty: none, gyro-only,
+  /// steadiface, and the video-scored ones and ffmpeg's when it is there.
+  std::vector<std::string> methods;
+  /// Sequence length [s]; NaN: 3 s, or a recorded gyro trace's whole length.
+  double duration_s = NAN;
+  /// Frame size [px] and the simulator's seed.
+  int width = 640, height = 360;
+  uint64_t seed = 1;
+  /// Render every output (scores the warps either way).
+  bool render = false;
+
+  /// The recorded trace's rotation scale and playback speed [-].
+  double gyro_scale = NAN, gyro_speed = NAN;
+  /// The subject's distance [m].
+  double head_distance_m = NAN;
+
+  /// output.crop_ratio [-].
+  double crop = NAN;
+  /// face.search_interval [s].
+  double search_interval_s = NAN;
+  /// rotation_source visual (the IMU unused).
+  bool visual_rotation = false;
+  /// head.w_stay [-] and head.d_ref [fraction of the width].
+  double head_w_stay = NAN, head_d_ref = NAN;
+  /// stabilizer.subject_reach [jaw widths] (0: off), its low-pass [Hz] and hold.
+  double subject_reach = 0.0, reach_lowpass_hz = NAN, reach_hold = NAN;
+  /// Added to imu/time_offset and camera/readout_time [s] (calibration
+  /// studies: a deliberately wrong IMU timing).
+  double offset_error_s = 0.0, readout_error_s = 0.0;
+  /// The layered warp's blend and the composite's options, as given.
+  LayerBlendOptions blend;
+  CompositeOptions composite;
+  ViewOverrides view;
+
+  /// Also feasible_<preset>_<method>.csv (and _roll.csv with a roll [rad] > 0).
+  bool feasible_set = false;
+  double feasible_roll = 0.0;
+  /// Layered: also reach_<preset>_<method>.csv.
+  bool reach_tube = false;
+  /// Composite: every 15th frame's pictures (composite_<preset>_*.png).
+  bool composite_frames = false;
+  /// >= 0: <preset>_<method>_frame.png and _average15.png around that frame.
+  int average_at = -1;
+};
+
+/// Applies the overrides to one method's pipeline options.
+void ApplyViewOverrides(const ViewOverrides& view, PipelineOptions* options);
+
+/// Runs every preset with every method and scores each against the
+/// simulator's truth. Prints one markdown row per (preset, method) to `out`
+/// (and the composite's quality table when a composite ran), writes
+/// report.json, traj_<preset>_<method>.csv and the extra files under
+/// out_dir, and reports failures to `err`. Returns the process's exit
+/// status: 0 all ran, 1 some failed, 2 a method is unknown or needs ffmpeg.
+int RunEvaluation(const EvaluationOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace eval
+}  // namespace steadiface

@@ -1,0 +1,121 @@
+// RunEvaluation (steadiface_evaluate's library): its table row is the
+// scorecard of the same run made directly, its files are there with a row
+// per frame, and a request it cannot serve is refused with exit status 2.
+#include "steadiface_core/eval/evaluation.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "sim_util.h"
+#include "steadiface_core/eval/run_methods.h"
+
+namespace steadiface {
+namespace {
+
+std::string TempDir() {
+  char tmpl[] = "/tmp/steadiface_evaluation_test_XXXXXX";
+  EXPECT_NE(mkdtemp(tmpl), nullptr);
+  return tmpl;
+}
+
+int Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) ++n;
+  return n;
+}
+
+eval::EvaluationOptions ShortStill(const std::string& out_dir) {
+  eval::EvaluationOptions o;
+  o.data_dir = STEADIFACE_TEST_DATA_DIR;
+  o.out_dir = out_dir;
+  o.presets = {"still"};
+  o.methods = {"none", "gyro-only"};
+  o.duration_s = 0.5;
+  return o;
+}
+
+TEST(EvaluationTest, RowsAreTheScorecardsOfTheSameRuns) {
+  const std::string dir = TempDir();
+  std::ostringstream out, err;
+  ASSERT_EQ(eval::RunEvaluation(ShortStill(dir), out, err), 0) << err.str();
+  // The same run made directly: the simulator, the method's options, the scorecard.
+  const std::unique_ptr<sim::Simulator> sim = testing_util::MakeSimulator(
+      "still", [](sim::SimulatorOptions* so) { so->duration_s = 0.5; });
+  ASSERT_NE(sim, nullptr);
+  const PipelineOptions po = eval::OptionsFor(*sim, eval::Method::kGyroOnly);
+  std::unique_ptr<eval::Scorecard> card;
+  ASSERT_TRUE(eval::MakeScorecard(*sim, po, &card).ok());
+  ASSERT_TRUE(eval::RunMethod(*sim, eval::Method::kGyroOnly, po, false, card.get(), nullptr).ok());
+  const eval::Score sc = card->Compute();
+  char expected[160];
+  std::snprintf(expected, sizeof(expected), "| still | gyro-only | %.2f | %.3f |",
+                sc.head_jitter_px, 100 * sc.head_jitter_frac);
+  ASSERT_TRUE(std::isfinite(sc.head_jitter_px));
+  EXPECT_NE(out.str().find(expected), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("| still | none | "), std::string::npos);
+  // A trajectory per method with a row per frame, and both runs in the report.
+  const int frames = sim->num_frames();
+  EXPECT_EQ(Lines(dir + "/traj_still_none.csv"), frames + 1);
+  EXPECT_EQ(Lines(dir + "/traj_still_gyro-only.csv"), frames + 1);
+  std::ifstream json(dir + "/report.json");
+  const std::string report((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("\"method\": \"gyro-only\", \"scoring\": \"exact\", \"frames\": " +
+                        std::to_string(sc.frames)),
+            std::string::npos)
+      << report;
+  std::remove((dir + "/traj_still_none.csv").c_str());
+  std::remove((dir + "/traj_still_gyro-only.csv").c_str());
+  std::remove((dir + "/report.json").c_str());
+  rmdir(dir.c_str());
+}
+
+TEST(EvaluationTest, UnknownMethodsAndPresetsAreRefused) {
+  const std::string dir = TempDir();
+  eval::EvaluationOptions o = ShortStill(dir);
+  o.methods = {"gyro-only", "sideways"};
+  std::ostringstream out, err;
+  EXPECT_EQ(eval::RunEvaluation(o, out, err), 2);
+  EXPECT_NE(err.str().find("unknown method sideways"), std::string::npos);
+  o.methods = {"none"};
+  o.presets = {"no_such_preset"};
+  std::ostringstream out2, err2;
+  EXPECT_EQ(eval::RunEvaluation(o, out2, err2), 1);  // ran, and that preset failed
+  EXPECT_NE(err2.str().find("preset no_such_preset: unknown preset"), std::string::npos)
+      << err2.str();
+  std::remove((dir + "/report.json").c_str());
+  rmdir(dir.c_str());
+}
+
+TEST(EvaluationTest, ViewOverridesChangeOnlyWhatTheyName) {
+  PipelineOptions po, before;
+  eval::ViewOverrides v;
+  eval::ApplyViewOverrides(v, &po);  // nothing set: nothing changes
+  EXPECT_EQ(po.crop.mode, before.crop.mode);
+  EXPECT_EQ(po.horizon.mode, before.horizon.mode);
+  EXPECT_EQ(po.crop.widest_crop_ratio, before.crop.widest_crop_ratio);
+  v.crop_mode = 1;
+  v.horizon = "lock";
+  v.widest = 0.05;
+  v.start_tight = true;
+  eval::ApplyViewOverrides(v, &po);
+  EXPECT_EQ(po.crop.mode, CropMode::kDynamic);
+  EXPECT_EQ(po.horizon.mode, HorizonMode::kLock);
+  EXPECT_EQ(po.crop.widest_crop_ratio, 0.05);
+  EXPECT_FALSE(po.crop.start_wide);
+  EXPECT_EQ(po.crop.headroom, before.crop.headroom);
+}
+
+}  // namespace
+}  // namespace steadiface
