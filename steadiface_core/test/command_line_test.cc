@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -126,4 +127,38 @@ TEST(CommandLineTest, NumbersMustBeWholeAndInRange) {
 }
 
 }  // namespace
+// The tools' shared start: help to `out` with 0, errors and missing
+// required arguments to `err` with the usage and 2, else run.
+TEST(CommandLineTest, StartEndsOnHelpErrorsAndMissingArgumentsAndElseRuns) {
+  std::string in;
+  CommandLine cl;
+  cl.String("--in", &in);
+  const auto ready = [&in] { return !in.empty(); };
+  auto start = [&](std::vector<const char*> argv, std::string* out, std::string* err, int* code) {
+    argv.insert(argv.begin(), "tool");
+    std::ostringstream o, e;
+    const bool run = cl.Start(static_cast<int>(argv.size()), argv.data(), "tool", "usage: tool\n",
+                              ready, o, e, code);
+    *out = o.str();
+    *err = e.str();
+    return run;
+  };
+  std::string out, err;
+  int code = -1;
+  EXPECT_FALSE(start({"--help"}, &out, &err, &code));
+  EXPECT_EQ(code, 0);
+  EXPECT_EQ(out, "usage: tool\n");
+  EXPECT_EQ(err, "");
+  EXPECT_FALSE(start({"--bogus"}, &out, &err, &code));
+  EXPECT_EQ(code, 2);
+  EXPECT_EQ(err, "tool: unknown argument '--bogus'\nusage: tool\n");
+  EXPECT_FALSE(start({}, &out, &err, &code));  // --in is required
+  EXPECT_EQ(code, 2);
+  EXPECT_EQ(err, "usage: tool\n");
+  code = -1;
+  EXPECT_TRUE(start({"--in", "x.bag"}, &out, &err, &code));
+  EXPECT_EQ(code, -1);
+  EXPECT_EQ(in, "x.bag");
+}
+
 }  // namespace steadiface

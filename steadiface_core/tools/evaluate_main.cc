@@ -32,49 +32,47 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
-int Usage() {
-  // clang-format off
-  std::cerr << "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
-               "       [--methods none,gyro-only,steadiface,steadiface-layered,none/video,\n"
-               "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
-               "       [--size WxH] [--seed N] [--render] [--crop R]\n"
-               "       [--band W] [--band-inside F] [--outline-margin CELLS] [--max-offset C] [--offset-lowpass HZ]\n"
-               "       [--yield-to-background] (the layered warp's warp/layered/* options,\n"
-               "         for sweeps; the last sets yield_to_subject false)\n"
-               "       [--offset-error S] [--readout-error S] (misconfigure the IMU timing)\n"
-               "       [--gyro-scale K] [--gyro-speed K] (presets with the recorded gyro\n"
-               "         trace: scale its rotation, or play it K times as fast)\n"
-               "       [--search-interval S] (face.search_interval: full-frame face search\n"
-               "         at most once per S while no face is locked; 0 = every frame)\n"
-               "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
-               "         shows a 30 px face)\n"
-               "       [--crop-mode fixed|dynamic] (output.crop: the fixed crop ratio, or the\n"
-               "         dynamic crop between --widest R and it; default: the package's)\n"
-               "       [--horizon off|level|lock] (output.horizon: the roll against the\n"
-               "         accelerometer's gravity)\n"
-               "       [--rotation-source imu|visual] (visual: the camera's rotation from\n"
-               "         the video, the IMU unused)\n"
-               "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
-               "         widths of where the background layer shows the face)\n"
-               "       [--reach-lowpass HZ] [--reach-hold F] (stabilizer.subject_reach_lowpass,\n"
-               "         subject_reach_hold: H follows the slow part of that position)\n"
-               "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
-               "         head target's smoothing, Eq. 1)\n"
-               "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
-               "         per frame, the crop-window shifts the margin allows, rolling shutter\n"
-               "         included, in 72 directions [input px], for scripts/analysis/crop_bound.py)\n"
-               "       [--face-core CELLS] (warp/layered/face_core)\n"
-               "       [--reach-tube] (layered: also reach_<preset>_<method>.csv: per frame,\n"
-               "         the true head through the background layer's pose and the radius\n"
-               "         H was held within there, both in output px; for\n"
-               "         scripts/analysis/reach_bound.py)\n"
-               "       [--feasible-roll MAX] (with --feasible-set, also\n"
-               "         feasible_<preset>_<method>_roll.csv: the same for a window that also\n"
-               "         rolls, every 0.025 rad within +-MAX, and the true head's move when it\n"
-               "         does; for crop_bound.py --feasible-roll)\n";
-  // clang-format on
-  return 2;
-}
+// clang-format off
+const char kUsage[] =
+    "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
+    "       [--methods none,gyro-only,steadiface,steadiface-layered,none/video,\n"
+    "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
+    "       [--size WxH] [--seed N] [--render] [--crop R]\n"
+    "       [--band W] [--band-inside F] [--outline-margin CELLS] [--max-offset C] [--offset-lowpass HZ]\n"
+    "       [--yield-to-background] (the layered warp's warp/layered/* options,\n"
+    "         for sweeps; the last sets yield_to_subject false)\n"
+    "       [--offset-error S] [--readout-error S] (misconfigure the IMU timing)\n"
+    "       [--gyro-scale K] [--gyro-speed K] (presets with the recorded gyro\n"
+    "         trace: scale its rotation, or play it K times as fast)\n"
+    "       [--search-interval S] (face.search_interval: full-frame face search\n"
+    "         at most once per S while no face is locked; 0 = every frame)\n"
+    "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
+    "         shows a 30 px face)\n"
+    "       [--crop-mode fixed|dynamic] (output.crop: the fixed crop ratio, or the\n"
+    "         dynamic crop between --widest R and it; default: the package's)\n"
+    "       [--horizon off|level|lock] (output.horizon: the roll against the\n"
+    "         accelerometer's gravity)\n"
+    "       [--rotation-source imu|visual] (visual: the camera's rotation from\n"
+    "         the video, the IMU unused)\n"
+    "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
+    "         widths of where the background layer shows the face)\n"
+    "       [--reach-lowpass HZ] [--reach-hold F] (stabilizer.subject_reach_lowpass,\n"
+    "         subject_reach_hold: H follows the slow part of that position)\n"
+    "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
+    "         head target's smoothing, Eq. 1)\n"
+    "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
+    "         per frame, the crop-window shifts the margin allows, rolling shutter\n"
+    "         included, in 72 directions [input px], for scripts/analysis/crop_bound.py)\n"
+    "       [--face-core CELLS] (warp/layered/face_core)\n"
+    "       [--reach-tube] (layered: also reach_<preset>_<method>.csv: per frame,\n"
+    "         the true head through the background layer's pose and the radius\n"
+    "         H was held within there, both in output px; for\n"
+    "         scripts/analysis/reach_bound.py)\n"
+    "       [--feasible-roll MAX] (with --feasible-set, also\n"
+    "         feasible_<preset>_<method>_roll.csv: the same for a window that also\n"
+    "         rolls, every 0.025 rad within +-MAX, and the true head's move when it\n"
+    "         does; for crop_bound.py --feasible-roll)\n";
+// clang-format on
 
 
 // What runs: the presets, methods, sequence and extra outputs.
@@ -160,16 +158,11 @@ int main(int argc, char** argv) {
   AddPipelineFlags(&cl, &o);
   AddCompositeFlags(&cl, &o.composite);
   AddViewFlags(&cl, &o.view);
-  std::string error;
-  const CommandLine::Result parsed = cl.Parse(argc, argv, &error);
-  if (parsed == CommandLine::Result::kHelp) {
-    Usage();
-    return 0;
+  int status = 0;
+  if (!cl.Start(argc, argv, "steadiface_evaluate", kUsage,
+                [&o] { return !o.data_dir.empty() && !o.out_dir.empty(); }, std::cout, std::cerr,
+                &status)) {
+    return status;
   }
-  if (parsed == CommandLine::Result::kError) {
-    std::cerr << "steadiface_evaluate: " << error << "\n";
-    return Usage();
-  }
-  if (o.data_dir.empty() || o.out_dir.empty()) return Usage();
   return steadiface::eval::RunEvaluation(o, std::cout, std::cerr);
 }

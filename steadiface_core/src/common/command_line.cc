@@ -127,4 +127,23 @@ CommandLine::Result CommandLine::Parse(int argc, const char* const* argv,
   return Result::kOk;
 }
 
+bool CommandLine::Start(int argc, const char* const* argv, const std::string& tool,
+                        const std::string& usage, const std::function<bool()>& ready,
+                        std::ostream& out, std::ostream& err, int* exit_status) const {
+  std::string error;
+  const Result parsed = Parse(argc, argv, &error);
+  if (parsed == Result::kHelp) {
+    out << usage;
+    *exit_status = 0;
+    return false;
+  }
+  if (parsed == Result::kError) err << tool << ": " << error << "\n";
+  if (parsed == Result::kError || (ready && !ready())) {
+    err << usage;
+    *exit_status = 2;
+    return false;
+  }
+  return true;
+}
+
 }  // namespace steadiface

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,22 @@ class CommandLine {
   Result Parse(int argc, const char* const* argv, std::string* error) const;
   Result Parse(int argc, char** argv, std::string* error) const {
     return Parse(argc, const_cast<const char* const*>(argv), error);
+  }
+
+  /// The tools' shared start: parses argv. --help or -h prints `usage` to
+  /// `out` (exit status 0); an unknown or malformed argument prints
+  /// "<tool>: <error>" and the usage to `err` (2); so does a missing
+  /// required argument (`ready` returns false after parsing; null: none is
+  /// required). True when the tool should run; otherwise *exit_status says
+  /// how it ends.
+  bool Start(int argc, const char* const* argv, const std::string& tool,
+             const std::string& usage, const std::function<bool()>& ready, std::ostream& out,
+             std::ostream& err, int* exit_status) const;
+  bool Start(int argc, char** argv, const std::string& tool, const std::string& usage,
+             const std::function<bool()>& ready, std::ostream& out, std::ostream& err,
+             int* exit_status) const {
+    return Start(argc, const_cast<const char* const*>(argv), tool, usage, ready, out, err,
+                 exit_status);
   }
 
  private:

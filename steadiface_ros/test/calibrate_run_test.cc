@@ -1,0 +1,66 @@
+// RunCalibration (steadiface_calibrate's run) on the simulated walk whose
+// IMU stamps are 30 ms early: the overlay it writes recovers the offset and
+// the identity mounting, and a recording it cannot use is refused with
+// nothing written.
+#include "steadiface_calibrate/calibrate_run.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+namespace steadiface_calibrate {
+namespace {
+
+class CalibrateRunTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char tmpl[] = "/tmp/steadiface_calibrate_run_test_XXXXXX";
+    ASSERT_NE(mkdtemp(tmpl), nullptr);
+    dir_ = tmpl;
+    o_.out = dir_ + "/overlay.yaml";
+    o_.report = dir_ + "/report.json";
+    o_.quiet = true;
+  }
+  void TearDown() override {
+    for (const char* f : {"/overlay.yaml", "/overlay.yaml.part", "/report.json"}) {
+      std::remove((dir_ + f).c_str());
+    }
+    rmdir(dir_.c_str());
+  }
+  std::string dir_;
+  CalibrateOptions o_;
+};
+
+TEST_F(CalibrateRunTest, RecoversTheClockOffsetOfARecording) {
+  o_.in = std::string(STEADIFACE_TEST_BAG_DIR) + "/check_offset.bag";
+  ASSERT_EQ(RunCalibration(o_), 0);
+  const YAML::Node y = YAML::LoadFile(o_.out);
+  EXPECT_NEAR(y["imu"]["time_offset"].as<double>(), 0.03, 0.002);
+  const std::vector<double> q = y["imu"]["R_cam_imu"].as<std::vector<double>>();
+  ASSERT_EQ(q.size(), 4u);
+  const Eigen::Quaterniond r(q[3], q[0], q[1], q[2]);
+  EXPECT_LT(r.angularDistance(Eigen::Quaterniond::Identity()), 0.02);  // [rad]
+  struct stat st;
+  EXPECT_EQ(stat(o_.report.c_str(), &st), 0);
+}
+
+TEST_F(CalibrateRunTest, ARecordingWithoutImuIsRefusedAndNothingWritten) {
+  o_.in = std::string(STEADIFACE_TEST_BAG_DIR) + "/check_offset.bag";
+  o_.topics.imu = "/nothing";
+  EXPECT_EQ(RunCalibration(o_), 1);
+  struct stat st;
+  EXPECT_NE(stat(o_.out.c_str(), &st), 0);
+  o_.in = dir_ + "/missing.bag";
+  EXPECT_EQ(RunCalibration(o_), 1);
+  EXPECT_NE(stat(o_.out.c_str(), &st), 0);
+}
+
+}  // namespace
+}  // namespace steadiface_calibrate

@@ -1,0 +1,303 @@
+#include "steadiface_calibrate/calibrate_run.h"
+
+#include <algorithm>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <ros/package.h>
+
+#include "steadiface_bag/bounded_queue.h"
+#include "steadiface_core/calibration/calibrator.h"
+#include "steadiface_ros/camera_info_source.h"
+#include "steadiface_ros/msg_conversion.h"
+#include "steadiface_ros/params.h"
+#include "steadiface_ros/time_conversion.h"
+
+namespace steadiface_calibrate {
+namespace {
+
+using steadiface::Status;
+
+// Angular speed from the video and the gyro, before and after, as a PNG.
+void Plot(const steadiface::CalibrationResult& r, const std::string& path) {
+  const int W = 1000, Hp = 260, pad = 40;
+  cv::Mat img(2 * Hp + pad, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  double vmax = 1e-6, tmax = 1e-6;
+  for (size_t i = 0; i < r.plot_t.size(); ++i) {
+    vmax = std::max(
+        {vmax, r.plot_video[i], r.plot_gyro_before[i], r.plot_gyro_after[i]});
+    tmax = std::max(tmax, r.plot_t[i]);
+  }
+  auto pt = [&](double t, double v, int panel) {
+    return cv::Point(
+        static_cast<int>(50 + (W - 70) * t / tmax),
+        static_cast<int>(panel * (Hp + pad) + Hp - 25 - (Hp - 50) * v / vmax));
+  };
+  for (int panel = 0; panel < 2; ++panel) {
+    const auto& gyro = panel == 0 ? r.plot_gyro_before : r.plot_gyro_after;
+    cv::rectangle(img, pt(0, 0, panel), pt(tmax, vmax, panel),
+                  cv::Scalar(200, 200, 200));
+    for (size_t i = 1; i < r.plot_t.size(); ++i) {
+      cv::line(img, pt(r.plot_t[i - 1], r.plot_video[i - 1], panel),
+               pt(r.plot_t[i], r.plot_video[i], panel), cv::Scalar(0, 0, 0), 1,
+               cv::LINE_AA);
+      cv::line(img, pt(r.plot_t[i - 1], gyro[i - 1], panel),
+               pt(r.plot_t[i], gyro[i], panel), cv::Scalar(0, 0, 220), 1,
+               cv::LINE_AA);
+    }
+    std::ostringstream title;
+    title << (panel == 0 ? "before (configured offset)"
+                         : "after (estimated offset, bias)")
+          << ": |omega| video (black), gyro (red); max " << std::setprecision(3)
+          << vmax << " rad/s over " << tmax << " s";
+    cv::putText(img, title.str(), cv::Point(55, panel * (Hp + pad) + 18),
+                cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1,
+                cv::LINE_AA);
+  }
+  cv::imwrite(path, img);
+}
+
+
+// The starting point: the package defaults and the user's overlays.
+Status LoadStart(const CalibrateOptions& o, steadiface::PipelineOptions* po,
+                 steadiface_ros::WrapperOptions* wo) {
+  std::vector<std::string> files;
+  const std::string pkg = ros::package::getPath("steadiface");
+  if (!pkg.empty()) files.push_back(pkg + "/config/default.yaml");
+  files.insert(files.end(), o.params.begin(), o.params.end());
+  std::unique_ptr<steadiface_ros::ParamSource> params;
+  Status st = steadiface_ros::YamlParams(files, &params);
+  if (st.ok()) st = steadiface_ros::LoadOptions(*params, po, wo);
+  return st;
+}
+
+// Feeds a bag's gyro samples and images to a Calibrator, made at the first
+// image (it needs the intrinsics).
+class Feeder {
+ public:
+  Feeder(const CalibrateOptions& o, const steadiface::PipelineOptions& po,
+         steadiface_ros::CameraInfoSource* info_source)
+      : o_(o), po_(po), info_source_(*info_source) {}
+  // Reads every message of `queue`; an error ends the run.
+  Status Feed(steadiface_bag::BoundedQueue<steadiface_bag::BagItem>* queue, size_t total);
+  std::unique_ptr<steadiface::Calibrator>& calibrator() { return cal_; }
+  size_t frames() const { return frames_; }
+  size_t skipped() const { return skipped_; }
+  size_t imu() const { return imu_; }
+
+ private:
+  void AddGyro(const sensor_msgs::Imu& m);
+  Status AddImage(const sensor_msgs::Image& image);
+
+  const CalibrateOptions& o_;
+  const steadiface::PipelineOptions& po_;
+  steadiface_ros::CameraInfoSource& info_source_;
+  std::unique_ptr<steadiface::Calibrator> cal_;
+  sensor_msgs::CameraInfoConstPtr last_info_;
+  size_t frames_ = 0, skipped_ = 0, imu_ = 0;
+  // Gyro samples before the first image (the calibrator needs its
+  // intrinsics first); bounded: an hour at 1 kHz would be 3.6e6.
+  static constexpr size_t kMaxEarly = 1000000;
+  std::vector<steadiface::GyroSample> early_;
+};
+
+void Feeder::AddGyro(const sensor_msgs::Imu& m) {
+  ++imu_;
+  if (cal_) {
+    cal_->AddGyro(steadiface_ros::ToGyroSample(m));
+  } else if (early_.size() < kMaxEarly) {
+    early_.push_back(steadiface_ros::ToGyroSample(m));  // until the first image
+  }
+}
+
+Status Feeder::AddImage(const sensor_msgs::Image& image) {
+  const sensor_msgs::CameraInfoConstPtr info = info_source_.Select(image, last_info_);
+  if (!info) {
+    ++skipped_;
+    return Status::Ok();
+  }
+  if (!cal_) {
+    steadiface::CameraIntrinsics k;
+    steadiface::CalibratorOptions co;
+    co.estimate_readout = o_.estimate_readout;
+    Status st = steadiface_ros::ToCameraIntrinsics(*info, &k);
+    if (st.ok()) {
+      st = steadiface::Calibrator::Create(k, po_.shutter, po_.imu.R_cam_imu,
+                                          po_.imu.imu_time_offset_s, co, &cal_);
+    }
+    if (!st.ok()) return st;
+    for (const auto& g : early_) cal_->AddGyro(g);
+    early_.clear();
+  }
+  cv::Mat cv_image;
+  Status st = steadiface_ros::ToCvImage(image, &cv_image);
+  if (st.ok()) st = cal_->AddFrame(cv_image, steadiface_ros::ToCoreTime(image.header.stamp));
+  if (st.ok()) {
+    ++frames_;
+  } else {
+    ++skipped_;
+  }
+  return Status::Ok();
+}
+
+Status Feeder::Feed(steadiface_bag::BoundedQueue<steadiface_bag::BagItem>* queue, size_t total) {
+  steadiface_bag::BagItem item;
+  while (queue->Pop(&item)) {
+    if (item.imu) AddGyro(*item.imu);
+    if (item.info) last_info_ = item.info;
+    if (!item.image) continue;
+    const size_t before = frames_;
+    const Status st = AddImage(*item.image);
+    if (!st.ok()) return st;
+    if (!o_.quiet && frames_ != before && frames_ % 100 == 0) {
+      std::cerr << "steadiface_calibrate: frame " << frames_ << " / " << total << "\n";
+    }
+  }
+  return Status::Ok();
+}
+
+// The overlay: the estimates with their uncertainties in comments.
+Status WriteOverlay(const steadiface::CalibrationResult& r, const std::string& in, size_t frames,
+                    const std::string& out) {
+  const Eigen::Quaterniond& q = r.R_cam_imu;
+  std::ofstream y(out + ".part");
+  y << std::setprecision(9);
+  y << "# steadiface_calibrate --in " << in << "\n"
+    << "# " << frames << " frames, " << r.pairs << " frame pairs, " << r.tracks
+    << " tracks; median reprojection residual " << r.residual_before_px
+    << " px (configured) -> " << r.residual_after_px
+    << " px. Uncertainties are formal 1-sigma (Ceres covariance).\n"
+    << "# Load with: roslaunch steadiface stabilize.launch params:=<this "
+       "file>\n"
+    << "#        or: steadiface_bag --in IN.bag --params <this file> ...\n"
+    << "imu:\n"
+    << "  R_cam_imu: [" << q.x() << ", " << q.y() << ", " << q.z() << ", "
+    << q.w() << "]  # +-" << r.rotation_sigma_deg << " deg; "
+    << r.misalignment_deg << " deg from the axis permutation ["
+    << r.nearest_permutation.x() << ", " << r.nearest_permutation.y() << ", "
+    << r.nearest_permutation.z() << ", " << r.nearest_permutation.w() << "]\n"
+    << "  time_offset: " << r.time_offset_s << "  # [s] +-"
+    << r.time_offset_sigma_s * 1e3 << " ms (coarse " << r.coarse_offset_s
+    << " s)\n"
+    << "  gyro_bias: [" << r.bias.x() << ", " << r.bias.y() << ", "
+    << r.bias.z() << "]  # [rad/s], IMU axes, +- [" << r.bias_sigma.x() << ", "
+    << r.bias_sigma.y() << ", " << r.bias_sigma.z() << "]\n";
+  if (r.readout_determined) {
+    y << "camera:\n  readout_time: " << r.readout_s << "  # [s] +-"
+      << r.readout_sigma_s * 1e3 << " ms\n";
+  } else {
+    y << "# camera/readout_time not determined (" << r.readout_s << " s +-"
+      << r.readout_sigma_s * 1e3 << " ms): left as configured\n";
+  }
+  y.close();
+  if (!y || std::rename((out + ".part").c_str(), out.c_str()) != 0) {
+    return Status::Error("cannot write '" + out + "'");
+  }
+  return Status::Ok();
+}
+
+void WriteReport(const steadiface::CalibrationResult& r, const std::string& in, size_t frames,
+                 size_t imu, const std::string& report) {
+  const Eigen::Quaterniond& q = r.R_cam_imu;
+  std::ofstream j(report);
+  j << std::setprecision(9) << "{\n  \"in\": \"" << in
+    << "\",\n  \"frames\": " << frames << ",\n  \"imu_samples\": " << imu
+    << ",\n  \"pairs\": " << r.pairs << ",\n  \"tracks\": " << r.tracks
+    << ",\n  \"duration_s\": " << r.duration_s
+    << ",\n  \"mean_angular_speed\": " << r.mean_angular_speed
+    << ",\n  \"R_cam_imu\": [" << q.x() << ", " << q.y() << ", " << q.z()
+    << ", " << q.w()
+    << "],\n  \"rotation_sigma_deg\": " << r.rotation_sigma_deg
+    << ",\n  \"misalignment_deg\": " << r.misalignment_deg
+    << ",\n  \"time_offset_s\": " << r.time_offset_s
+    << ",\n  \"time_offset_sigma_s\": " << r.time_offset_sigma_s
+    << ",\n  \"coarse_offset_s\": " << r.coarse_offset_s
+    << ",\n  \"readout_s\": " << r.readout_s
+    << ",\n  \"readout_sigma_s\": " << r.readout_sigma_s
+    << ",\n  \"readout_determined\": "
+    << (r.readout_determined ? "true" : "false") << ",\n  \"bias\": ["
+    << r.bias.x() << ", " << r.bias.y() << ", " << r.bias.z()
+    << "],\n  \"residual_before_px\": " << r.residual_before_px
+    << ",\n  \"residual_after_px\": " << r.residual_after_px
+    << ",\n  \"solver\": \"" << r.solver_report << "\"\n}\n";
+}
+
+void WritePlot(const steadiface::CalibrationResult& r, const std::string& dir) {
+  std::ofstream c(dir + "/angular_speed.csv");
+  c << "t,video,gyro_before,gyro_after\n";
+  for (size_t i = 0; i < r.plot_t.size(); ++i) {
+    c << r.plot_t[i] << "," << r.plot_video[i] << "," << r.plot_gyro_before[i]
+      << "," << r.plot_gyro_after[i] << "\n";
+  }
+  Plot(r, dir + "/angular_speed.png");
+}
+
+void PrintSummary(const steadiface::CalibrationResult& r, const std::string& out) {
+  const Eigen::Quaterniond& q = r.R_cam_imu;
+  std::cout << "steadiface_calibrate: time_offset " << r.time_offset_s * 1e3
+            << " ms (+-" << r.time_offset_sigma_s * 1e3 << "), readout "
+            << r.readout_s * 1e3 << " ms"
+            << (r.readout_determined ? "" : " (not determined)")
+            << ", R_cam_imu [" << q.x() << ", " << q.y() << ", " << q.z()
+            << ", " << q.w() << "] (" << r.misalignment_deg
+            << " deg from an axis permutation), residual "
+            << r.residual_before_px << " -> " << r.residual_after_px
+            << " px; wrote " << out << "\n";
+}
+
+// Reads the bag into a Calibrator and solves; the error says why not.
+Status Calibrate(const CalibrateOptions& o, steadiface::CalibrationResult* r, size_t* frames,
+                 size_t* imu) {
+  steadiface::PipelineOptions po;
+  steadiface_ros::WrapperOptions wo;
+  Status st = LoadStart(o, &po, &wo);
+  if (!st.ok()) return st;
+  const bool quiet = o.quiet;
+  steadiface_ros::CameraInfoSource info_source([quiet](bool is_error, const std::string& text) {
+    if (is_error || !quiet) std::cerr << "steadiface_calibrate: " << text << "\n";
+  });
+  st = info_source.Load(wo.camera_info_url);
+  steadiface_bag::BagReader reader(o.in, o.topics);
+  if (st.ok()) st = reader.Open(/*info_required=*/!info_source.has_file_info());
+  if (!st.ok()) return st;
+  steadiface_bag::BoundedQueue<steadiface_bag::BagItem> queue(64);
+  reader.Start(&queue);
+  Feeder feeder(o, po, &info_source);
+  st = feeder.Feed(&queue, reader.ImageCount());
+  if (!st.ok()) queue.Close();
+  const std::string reader_error = reader.Join();
+  if (!st.ok()) return st;
+  if (!reader_error.empty()) return Status::Error(reader_error);
+  if (!feeder.calibrator()) {
+    return Status::Error("no usable image in '" + o.in + "' (" +
+                         std::to_string(feeder.skipped()) + " skipped)");
+  }
+  *frames = feeder.frames();
+  *imu = feeder.imu();
+  st = feeder.calibrator()->Solve(r);
+  return st.ok() ? st : Status::Error(st.message() + "\nnothing written.");
+}
+
+}  // namespace
+
+int RunCalibration(const CalibrateOptions& o) {
+  steadiface::CalibrationResult r;
+  size_t frames = 0, imu = 0;
+  Status st = Calibrate(o, &r, &frames, &imu);
+  if (st.ok()) st = WriteOverlay(r, o.in, frames, o.out);
+  if (!st.ok()) {
+    std::cerr << "steadiface_calibrate: " << st.message() << "\n";
+    return 1;
+  }
+  if (!o.report.empty()) WriteReport(r, o.in, frames, imu, o.report);
+  if (!o.plot.empty()) WritePlot(r, o.plot);
+  PrintSummary(r, o.out);
+  return 0;
+}
+
+}  // namespace steadiface_calibrate
