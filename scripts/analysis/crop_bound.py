@@ -109,7 +109,7 @@ def project(poly, d):
     return out
 
 
-def main():
+def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("csv")
     ap.add_argument("--point", choices=["head", "bg"], default="head")
@@ -122,13 +122,32 @@ def main():
     ap.add_argument("--feasible-roll", default="", help="feasible_<preset>_<method>_roll.csv")
     ap.add_argument("--lookahead", type=int, default=-1, help="K frames known ahead")
     ap.add_argument("--smooth", type=float, default=0.5, help="lambda of --lookahead")
-    a = ap.parse_args()
-    W, H = (float(v) for v in a.size.split("x"))
+    return ap.parse_args()
+
+
+def read_rolls(path, frames):
+    """[(head shift (n, 2), polygons (n, k, 2))] per roll of a _roll.csv, and
+    the largest roll."""
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    rolls = []
+    for roll in sorted({r["roll"] for r in rows}, key=float):
+        sel = [r for r in rows if r["roll"] == roll]
+        if len(sel) != frames:
+            raise SystemExit("%s has %d frames at roll %s, expected %d"
+                             % (path, len(sel), roll, frames))
+        shift = np.array([[float(r["head_dx"]), float(r["head_dy"])] for r in sel])
+        r_k = np.array([[float(v) for v in list(r.values())[4:]] for r in sel])
+        rolls.append((np.nan_to_num(shift), polygons(r_k)))
+    return rolls, max(abs(float(r["roll"])) for r in rows)
+
+
+def read_inputs(a):
+    """The point's track, its running mean (from the file's first frame),
+    the measured feasible radii and rolls, all cut to --frames."""
     keys = ("head_in_x", "head_in_y") if a.point == "head" else ("bg_out_x", "bg_out_y")
     with open(a.csv) as f:
         x = np.array([[float(r[keys[0]]), float(r[keys[1]])] for r in csv.DictReader(f)])
-    # The running mean starts at the first frame of the file, the scoring
-    # (and the policies' windows) at --frames.
     mean = np.zeros_like(x)
     mean[0] = x[0]
     for i in range(1, len(x)):
@@ -139,42 +158,34 @@ def main():
             radii = np.array([[float(v) for v in list(r.values())[1:]] for r in csv.DictReader(f)])
         if len(radii) != len(x):
             raise SystemExit("%s has %d frames, %s %d" % (a.feasible, len(radii), a.csv, len(x)))
-    rolls = []  # (head shift (n, 2), polygons (n, k, 2)) per roll
-    if a.feasible_roll:
-        with open(a.feasible_roll) as f:
-            rows = list(csv.DictReader(f))
-        for roll in sorted({r["roll"] for r in rows}, key=float):
-            sel = [r for r in rows if r["roll"] == roll]
-            if len(sel) != len(x):
-                raise SystemExit("%s has %d frames at roll %s, %s %d"
-                                 % (a.feasible_roll, len(sel), roll, a.csv, len(x)))
-            shift = np.array([[float(r["head_dx"]), float(r["head_dy"])] for r in sel])
-            r_k = np.array([[float(v) for v in list(r.values())[4:]] for r in sel])
-            rolls.append((np.nan_to_num(shift), polygons(r_k)))
-        max_roll = max(abs(float(r["roll"])) for r in rows)
+    rolls, max_roll = read_rolls(a.feasible_roll, len(x)) if a.feasible_roll else ([], 0.0)
     if a.frames:
         lo, hi = (int(v) for v in a.frames.split(":"))
         x, mean = x[lo:hi], mean[lo:hi]
         if radii is not None:
             radii = radii[lo:hi]
         rolls = [(sh[lo:hi], po[lo:hi]) for sh, po in rolls]
-    n = len(x)
-    A = highpass_matrix(n, a.fps, 0.5)
-    L = np.linalg.eigvalsh(A.T @ A).max()
-    j_in = jitter(A, x)
-    K = a.lookahead
-    print("| crop per side | input px | causal clamp px | vs input | causal recentre px | vs input "
-          "| non-causal optimum px | vs input |"
-          + (" recentre, %d-frame lookahead px | vs input |" % K if K >= 0 else ""))
-    print("|---|---|---|---|---|---|---|---|" + ("---|---|" if K >= 0 else ""))
+    return x, mean, radii, rolls, max_roll
 
-    def lookahead(allowed):
+
+class Bound(object):
+    """The policies' jitter on one track: a causal clamp, a causal
+    recentre, the non-causal optimum and (K >= 0) a K-frame lookahead."""
+
+    def __init__(self, x, mean, fps, lookahead, smooth):
+        self.x, self.mean, self.n = x, mean, len(x)
+        self.A = highpass_matrix(self.n, fps, 0.5)
+        self.L = np.linalg.eigvalsh(self.A.T @ self.A).max()
+        self.j_in = jitter(self.A, x)
+        self.K, self.smooth = lookahead, smooth
+
+    def lookahead(self, allowed):
         """The recentre policy knowing frames i..i+K (projected gradient on
         each window's convex problem, 300 steps)."""
-        lam = a.smooth
+        x, mean, lam = self.x, self.mean, self.smooth
         p = np.zeros_like(x)
-        for i in range(n):
-            f = slice(i, min(n, i + K + 1))
+        for i in range(self.n):
+            f = slice(i, min(self.n, i + self.K + 1))
             prev = p[i - 1] if i > 0 else None
             q = x[f] + allowed(mean[f] - x[f], f)
             for _ in range(300):
@@ -188,51 +199,71 @@ def main():
             p[i] = q[0]
         return p
 
-    def row(label, r, allowed, iterations, optimum=True):
+    def row(self, label, r, allowed, iterations, optimum=True):
         """One table row: the three policies, each wanted shift d (window
         shift, input px) replaced by allowed(d, frames), the closest one the
         margin allows on those frames."""
+        x, A, j_in = self.x, self.A, self.j_in
         clamp = np.zeros_like(x)
         clamp[0] = x[0] + allowed(np.zeros((1, 2)), slice(0, 1))[0]
-        for i in range(1, n):
+        for i in range(1, self.n):
             clamp[i] = x[i] + allowed((clamp[i - 1] - x[i])[None], slice(i, i + 1))[0]
-        recentre = x + allowed(mean - x, slice(None))
+        recentre = x + allowed(self.mean - x, slice(None))
         best = clamp.copy()
         for _ in range(iterations if optimum else 0):
-            best = x + allowed(best - (A.T @ (A @ best)) / L - x, slice(None))
+            best = x + allowed(best - (A.T @ (A @ best)) / self.L - x, slice(None))
         zoom = 1.0 / (1.0 - 2.0 * r)
         jc, jr, jo = (zoom * jitter(A, p) for p in (clamp, recentre, best))
         line = ("| %s | %.2f | %.2f | %.2fx | %.2f | %.2fx | " % (label, j_in, jc, jc / j_in, jr, jr / j_in)
                 + ("%.2f | %.2fx |" % (jo, jo / j_in) if optimum else "- | - |"))
-        if K >= 0:
-            jl = zoom * jitter(A, lookahead(allowed))
+        if self.K >= 0:
+            jl = zoom * jitter(A, self.lookahead(allowed))
             line += " %.2f | %.2fx |" % (jl, jl / j_in)
         print(line)
 
+
+def rolled_projector(rolls):
+    """allowed(d, frames) over the measured rolls: the closest head move to d
+    that some roll and its shifts allow."""
+    def rolled(d, frames):
+        best, cost = None, None
+        for shift, poly in rolls:
+            q = shift[frames] + project(poly[frames], d - shift[frames])
+            c = ((q - d) ** 2).sum(1)
+            if best is None:
+                best, cost = q, c
+            else:
+                better = c < cost
+                best[better], cost[better] = q[better], c[better]
+        return best
+    return rolled
+
+
+def main():
+    a = parse_args()
+    W, H = (float(v) for v in a.size.split("x"))
+    # The running mean starts at the first frame of the file, the scoring
+    # (and the policies' windows) at --frames.
+    x, mean, radii, rolls, max_roll = read_inputs(a)
+    bound = Bound(x, mean, a.fps, a.lookahead, a.smooth)
+    K = a.lookahead
+    print("| crop per side | input px | causal clamp px | vs input | causal recentre px | vs input "
+          "| non-causal optimum px | vs input |"
+          + (" recentre, %d-frame lookahead px | vs input |" % K if K >= 0 else ""))
+    print("|---|---|---|---|---|---|---|---|" + ("---|---|" if K >= 0 else ""))
     crops = [float(v) for v in a.crops.split(",")]
     for r in crops:
         M = np.array([r * W, r * H])
-        row("%g %%" % (100 * r), r, lambda d, frames: np.clip(d, -M, M), 20000)
+        bound.row("%g %%" % (100 * r), r, lambda d, frames: np.clip(d, -M, M), 20000)
     r = crops[0]  # the measured sets' rows: the crop of the run that wrote them
     if radii is not None:
         poly = polygons(radii)
-        row("%g %%, measured set" % (100 * r), r, lambda d, frames: project(poly[frames], d), 6000)
+        bound.row("%g %%, measured set" % (100 * r), r,
+                  lambda d, frames: project(poly[frames], d), 6000)
     if rolls:
-        def rolled(d, frames):
-            """The closest head move to d that some roll and its shifts allow."""
-            best, cost = None, None
-            for shift, poly in rolls:
-                q = shift[frames] + project(poly[frames], d - shift[frames])
-                c = ((q - d) ** 2).sum(1)
-                if best is None:
-                    best, cost = q, c
-                else:
-                    better = c < cost
-                    best[better], cost[better] = q[better], c[better]
-            return best
+        bound.row("%g %%, measured set, rolling +-%g rad" % (100 * r, max_roll), r,
+                  rolled_projector(rolls), 0, optimum=False)
 
-        row("%g %%, measured set, rolling +-%g rad" % (100 * r, max_roll), r, rolled, 0,
-            optimum=False)
 
 if __name__ == "__main__":
     main()

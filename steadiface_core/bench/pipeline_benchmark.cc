@@ -53,12 +53,10 @@ const Sequence& Get(int w, int h) {
   return cache.back().second;
 }
 
-void BM_PipelineFrame(benchmark::State& state) {
-  const Sequence& seq = Get(state.range(0), state.range(1));
-  if (seq.frames.size() < 10) {
-    state.SkipWithError("could not render the sequence");
-    return;
-  }
+// The benchmark's options: the method's, with the warp threads, the warp
+// mode (0 global, 1 layered, 2 composite), the rotation source (1 visual)
+// and the view (1: dynamic crop and level horizon) of the arguments 2-5.
+PipelineOptions BenchOptions(const Sequence& seq, const benchmark::State& state) {
   PipelineOptions po = eval::OptionsFor(*seq.sim, eval::Method::kSteadiface);
   po.render_output = true;
   po.warp.num_threads = static_cast<int>(state.range(2));
@@ -69,10 +67,61 @@ void BM_PipelineFrame(benchmark::State& state) {
     po.crop.mode = CropMode::kDynamic;
     po.horizon.mode = HorizonMode::kLevel;
   }
-  std::unique_ptr<Pipeline> p;
-  size_t g = 0, i = 0;
+  return po;
+}
+
+// Each stage's time per frame, and the counters they give.
+struct StageTimes {
   std::vector<double> face, stab, warp, mesh, composite, matte, plate, blend, total, visual, crop;
   double check_sum = 0.0, check_max = 0.0;
+
+  void Add(const PipelineFrame& out) {
+    face.push_back(out.timings.face_ms);
+    stab.push_back(out.timings.stabilizer_ms);
+    warp.push_back(out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms);
+    mesh.push_back(out.timings.mesh_ms);
+    composite.push_back(out.timings.composite_ms);
+    matte.push_back(out.composite.report.matte_ms);
+    plate.push_back(out.composite.report.plate_ms);
+    blend.push_back(out.composite.report.blend_ms);
+    total.push_back(out.timings.total_ms);
+    visual.push_back(out.visual.ms);
+    crop.push_back(out.timings.crop_ms);
+    check_sum += out.timings.check_ms;
+    check_max = std::max(check_max, out.timings.check_ms);
+  }
+
+  void Report(benchmark::State& state) const {
+    state.counters["face_ms"] = Percentile(face, 0.5);
+    state.counters["stabilizer_ms"] = Percentile(stab, 0.5);
+    state.counters["warp_ms"] = Percentile(warp, 0.5);
+    state.counters["mesh_ms"] = Percentile(mesh, 0.5);
+    state.counters["composite_ms"] = Percentile(composite, 0.5);
+    state.counters["matte_ms"] = Percentile(matte, 0.5);
+    state.counters["plate_ms"] = Percentile(plate, 0.5);
+    state.counters["blend_ms"] = Percentile(blend, 0.5);
+    state.counters["visual_ms"] = Percentile(visual, 0.5);
+    state.counters["crop_ms"] = Percentile(crop, 0.5);
+    // The gyro-vs-video check runs on one frame pair in `stride`: its mean
+    // per frame, and the checked frames' cost.
+    state.counters["check_mean_ms"] = total.empty() ? 0.0 : check_sum / total.size();
+    state.counters["check_max_ms"] = check_max;
+    // The headline target is a median (the reported time is a mean, which
+    // includes the periodic re-detection frames).
+    state.counters["total_p50_ms"] = Percentile(total, 0.5);
+  }
+};
+
+void BM_PipelineFrame(benchmark::State& state) {
+  const Sequence& seq = Get(state.range(0), state.range(1));
+  if (seq.frames.size() < 10) {
+    state.SkipWithError("could not render the sequence");
+    return;
+  }
+  const PipelineOptions po = BenchOptions(seq, state);
+  std::unique_ptr<Pipeline> p;
+  size_t g = 0, i = 0;
+  StageTimes times;
   // A fresh pipeline that has acquired the face on the first frame.
   auto restart = [&]() -> bool {
     if (!Pipeline::Create(seq.sim->intrinsics(), po, &p).ok()) return false;
@@ -102,37 +151,9 @@ void BM_PipelineFrame(benchmark::State& state) {
       state.SkipWithError(s.message().c_str());
       break;
     }
-    face.push_back(out.timings.face_ms);
-    stab.push_back(out.timings.stabilizer_ms);
-    warp.push_back(out.timings.mesh_ms + out.timings.maps_ms + out.timings.remap_ms);
-    mesh.push_back(out.timings.mesh_ms);
-    composite.push_back(out.timings.composite_ms);
-    matte.push_back(out.composite.report.matte_ms);
-    plate.push_back(out.composite.report.plate_ms);
-    blend.push_back(out.composite.report.blend_ms);
-    total.push_back(out.timings.total_ms);
-    visual.push_back(out.visual.ms);
-    crop.push_back(out.timings.crop_ms);
-    check_sum += out.timings.check_ms;
-    check_max = std::max(check_max, out.timings.check_ms);
+    times.Add(out);
   }
-  state.counters["face_ms"] = Percentile(face, 0.5);
-  state.counters["stabilizer_ms"] = Percentile(stab, 0.5);
-  state.counters["warp_ms"] = Percentile(warp, 0.5);
-  state.counters["mesh_ms"] = Percentile(mesh, 0.5);
-  state.counters["composite_ms"] = Percentile(composite, 0.5);
-  state.counters["matte_ms"] = Percentile(matte, 0.5);
-  state.counters["plate_ms"] = Percentile(plate, 0.5);
-  state.counters["blend_ms"] = Percentile(blend, 0.5);
-  state.counters["visual_ms"] = Percentile(visual, 0.5);
-  state.counters["crop_ms"] = Percentile(crop, 0.5);
-  // The gyro-vs-video check runs on one frame pair in `stride`: its mean
-  // per frame, and the checked frames' cost.
-  state.counters["check_mean_ms"] = total.empty() ? 0.0 : check_sum / total.size();
-  state.counters["check_max_ms"] = check_max;
-  // The headline target is a median (the reported time is a mean, which
-  // includes the periodic re-detection frames).
-  state.counters["total_p50_ms"] = Percentile(total, 0.5);
+  times.Report(state);
   state.counters["face_valid"] = out.face.valid;
 }
 

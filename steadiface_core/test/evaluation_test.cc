@@ -11,12 +11,14 @@
 #include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "sim_util.h"
+#include "steadiface_core/eval/calibration_sweep.h"
 #include "steadiface_core/eval/run_methods.h"
 
 namespace steadiface {
@@ -115,6 +117,44 @@ TEST(EvaluationTest, ViewOverridesChangeOnlyWhatTheyName) {
   EXPECT_EQ(po.crop.widest_crop_ratio, 0.05);
   EXPECT_FALSE(po.crop.start_wide);
   EXPECT_EQ(po.crop.headroom, before.crop.headroom);
+}
+
+// The sweep's default grid pairs each permutation with one offset x
+// readout cell in turn, so every permutation, offset and readout appears.
+TEST(CalibrationSweepTest, TheCyclingGridCoversEveryValue) {
+  eval::CalibrationSweepOptions o;
+  o.formats = {"640x360"};
+  o.seeds = {1};
+  const std::vector<eval::SweepJob> jobs = eval::SweepJobs(o);
+  ASSERT_EQ(jobs.size(), 24u);
+  std::set<int> perms;
+  std::set<double> offsets, readouts;
+  for (const auto& j : jobs) {
+    perms.insert(j.permutation);
+    offsets.insert(j.offset_s);
+    readouts.insert(j.readout_s);
+  }
+  EXPECT_EQ(perms.size(), 24u);
+  EXPECT_EQ(offsets.size(), o.offsets.size());
+  EXPECT_EQ(readouts.size(), o.readouts.size());
+  o.full = true;
+  EXPECT_EQ(eval::SweepJobs(o).size(), 24u * o.offsets.size() * o.readouts.size());
+}
+
+// One recording of the sweep: a permuted, tilted IMU 12 ms late and a 10 ms
+// readout, calibrated from nothing configured.
+TEST(CalibrationSweepTest, OneRecordingIsCalibrated) {
+  eval::CalibrationSweepOptions o;
+  o.data_dir = STEADIFACE_TEST_DATA_DIR;
+  const eval::SweepJob job{"640x360", 1, 5, 0.012, 0.010};
+  CalibrationResult r;
+  Eigen::Quaterniond mounting;
+  const Status st = eval::RunSweepJob(o, job, &r, &mounting);
+  ASSERT_TRUE(st.ok()) << st.message();
+  EXPECT_NEAR(r.time_offset_s, 0.012, 0.001);
+  EXPECT_NEAR(r.readout_s, 0.010, 0.002);
+  EXPECT_LT(r.R_cam_imu.angularDistance(mounting) * 180.0 / M_PI, 0.3);
+  EXPECT_GT(mounting.angularDistance(Eigen::Quaterniond::Identity()), 0.5);  // not trivial
 }
 
 }  // namespace

@@ -93,6 +93,114 @@ TEST(LandmarkPredictorTest, SameLandmarksAsDlibsShapePredictor) {
   EXPECT_EQ(compared, 5 * 68);
 }
 
+// A predictor loaded with `cache_dir`: whether it came from the cache.
+bool LoadedFromCache(const std::string& cache_dir, bool* packed = nullptr) {
+  std::unique_ptr<LandmarkPredictor> p;
+  EXPECT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, cache_dir).ok());
+  if (!p) return false;
+  if (packed != nullptr) *packed = p->loaded_packed_from_cache();
+  return p->loaded_from_cache();
+}
+
+// The cache file cut in half: ignored, and rewritten to its full size.
+void ExpectACutCacheIsRewritten(const std::string& dir, const std::string& file) {
+  struct stat st;
+  ASSERT_EQ(stat(file.c_str(), &st), 0);
+  const off_t full_size = st.st_size;
+  ASSERT_EQ(truncate(file.c_str(), full_size / 2), 0);
+  EXPECT_FALSE(LoadedFromCache(dir));
+  ASSERT_EQ(stat(file.c_str(), &st), 0);
+  EXPECT_EQ(st.st_size, full_size);
+  EXPECT_TRUE(LoadedFromCache(dir));
+}
+
+// A damaged count (the number of cascades, to one the file's size would
+// allow on its own): refused, decoded again from the model file.
+void ExpectADamagedCountIsRefused(const std::string& dir, const std::string& file,
+                                  const cv::Mat& grey, const cv::Rect2d& box,
+                                  const std::vector<Eigen::Vector2d>& reference) {
+  struct stat st;
+  ASSERT_EQ(stat(file.c_str(), &st), 0);
+  const long at = CascadeCountOffset(file);
+  uint64_t cascades = 0;
+  ASSERT_TRUE(ReadAt(file, at, &cascades));
+  EXPECT_EQ(cascades, 15u);  // the 68-point model's
+  const uint64_t damaged = static_cast<uint64_t>(st.st_size) / 16;
+  ASSERT_TRUE(WriteAt(file, at, damaged));
+  std::unique_ptr<LandmarkPredictor> p;
+  ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+  EXPECT_FALSE(p->loaded_from_cache());
+  std::vector<Eigen::Vector2d> again;
+  ASSERT_TRUE(p->Predict(grey, box, &again).ok());
+  ASSERT_EQ(again.size(), reference.size());
+  EXPECT_EQ(again[30].x(), reference[30].x());
+}
+
+// A split index past the cascade's features (Predict would read out of
+// bounds with it): refused, decoded again, rewritten.
+void ExpectABadSplitIsRefused(const std::string& dir, const std::string& file) {
+  // After the cascade count: trees, splits and leaves per tree; then per
+  // cascade its 500 anchors and 500 deltas (each with its count), then
+  // the split count and the first split's idx1.
+  const long counts = CascadeCountOffset(file);
+  uint64_t c[4] = {0, 0, 0, 0};
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(ReadAt(file, counts + 8 * i, &c[i]));
+  EXPECT_EQ(c[0], 15u);
+  EXPECT_EQ(c[1], 500u);
+  EXPECT_EQ(c[2], 15u);
+  EXPECT_EQ(c[3], 16u);
+  const long first_split = counts + 32 + 15 * (8 + 500 * 8 + 8 + 500 * 8) + 8;
+  uint32_t idx1 = 0;
+  ASSERT_TRUE(ReadAt(file, first_split, &idx1));
+  EXPECT_LT(idx1, 500u);
+  ASSERT_TRUE(WriteAt(file, first_split, uint32_t{500}));
+  EXPECT_FALSE(LoadedFromCache(dir));  // released: else the memo hands it back
+  bool packed = false;
+  EXPECT_TRUE(LoadedFromCache(dir, &packed));
+  EXPECT_TRUE(packed);
+}
+
+// A cache in the plain form (dlib's structures, as older versions wrote
+// it): read, packed, and rewritten in the packed form for the next run.
+void ExpectAPlainCacheIsRepacked(const std::string& dir, const std::string& file,
+                                 const cv::Mat& grey, const cv::Rect2d& box,
+                                 const std::vector<Eigen::Vector2d>& reference) {
+  LandmarkModelKey key;
+  ASSERT_TRUE(StatLandmarkModel(kDefaultShapePredictorPath, &key));
+  {
+    LandmarkPredictor::Impl m;
+    std::ifstream in(kDefaultShapePredictorPath, std::ios::binary);
+    int version = 0;
+    dlib::deserialize(version, in);
+    dlib::deserialize(m.initial_shape, in);
+    dlib::deserialize(m.forests, in);
+    dlib::deserialize(m.anchor_idx, in);
+    dlib::deserialize(m.deltas, in);
+    m.WriteCache(dir, file, key);
+  }
+  std::string bytes;
+  ASSERT_TRUE(ReadWholeFile(file, &bytes));
+  EXPECT_EQ(bytes.substr(0, 8), "SFLMCAC1");
+  std::vector<Eigen::Vector2d> plain, repacked;
+  for (std::vector<Eigen::Vector2d>* out : {&plain, &repacked}) {
+    std::unique_ptr<LandmarkPredictor> p;
+    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+    EXPECT_TRUE(p->loaded_from_cache());
+    EXPECT_EQ(p->loaded_packed_from_cache(), out == &repacked);
+    ASSERT_TRUE(p->Predict(grey, box, out).ok());
+    if (out == &plain) {
+      ASSERT_TRUE(ReadWholeFile(file, &bytes));
+      EXPECT_EQ(bytes.substr(0, 8), "SFLMPAK2");
+    }
+  }
+  ASSERT_EQ(plain.size(), reference.size());
+  ASSERT_EQ(repacked.size(), reference.size());
+  for (size_t i = 0; i < reference.size(); ++i) {
+    EXPECT_EQ(plain[i], reference[i]) << i;
+    EXPECT_EQ(repacked[i], reference[i]) << i;
+  }
+}
+
 // The decoded-model cache gives the very same model: identical landmarks
 // to the last bit on a real photo, read straight into the packed trees (the
 // fast load); a damaged cache file is ignored and rewritten.
@@ -106,22 +214,15 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
   std::vector<Eigen::Vector2d> reference, cached;
   {
     std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(
-        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "").ok());
+    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, "").ok());
     EXPECT_FALSE(p->loaded_from_cache());
     EXPECT_FALSE(p->loaded_packed_from_cache());
     ASSERT_TRUE(p->Predict(grey, box, &reference).ok());
   }
-  {
-    std::unique_ptr<LandmarkPredictor> p;  // decodes the .dat, writes the cache
-    ASSERT_TRUE(
-        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-  }
+  EXPECT_FALSE(LoadedFromCache(dir));  // decodes the .dat, writes the cache
   {
     std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(
-        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
+    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
     EXPECT_TRUE(p->loaded_from_cache());
     // Straight into the packed trees, not through dlib's structures.
     EXPECT_TRUE(p->loaded_packed_from_cache());
@@ -132,127 +233,15 @@ TEST(LandmarkPredictorTest, ModelCacheGivesTheSameLandmarks) {
     EXPECT_EQ(cached[i].x(), reference[i].x()) << i;
     EXPECT_EQ(cached[i].y(), reference[i].y()) << i;
   }
-  // Damage the cache (cut it in half): ignored, and rewritten.
   std::vector<cv::String> files;
   cv::glob(dir + "/*.sfcache", files, false);
   ASSERT_EQ(files.size(), 1u);
-  struct stat st;
-  ASSERT_EQ(stat(files[0].c_str(), &st), 0);
-  const off_t full_size = st.st_size;
-  ASSERT_EQ(truncate(files[0].c_str(), full_size / 2), 0);
-  {
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(
-        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-  }
-  ASSERT_EQ(stat(files[0].c_str(), &st), 0);
-  EXPECT_EQ(st.st_size, full_size);
-  {
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(
-        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_TRUE(p->loaded_from_cache());
-  }
-  // Damage a count (the number of cascades, to one the file's size would
-  // allow on its own): refused, decoded again from the model file.
-  {
-    const long at = CascadeCountOffset(files[0]);
-    uint64_t cascades = 0;
-    ASSERT_TRUE(ReadAt(files[0], at, &cascades));
-    EXPECT_EQ(cascades, 15u);  // the 68-point model's
-    const uint64_t damaged = static_cast<uint64_t>(full_size) / 16;
-    ASSERT_TRUE(WriteAt(files[0], at, damaged));
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(
-        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-    std::vector<Eigen::Vector2d> again;
-    ASSERT_TRUE(p->Predict(grey, box, &again).ok());
-    ASSERT_EQ(again.size(), reference.size());
-    EXPECT_EQ(again[30].x(), reference[30].x());
-  }
-  // A split index past the cascade's features (Predict would read out of
-  // bounds with it): refused, decoded again, rewritten.
-  {
-    // After the cascade count: trees, splits and leaves per tree; then per
-    // cascade its 500 anchors and 500 deltas (each with its count), then
-    // the split count and the first split's idx1.
-    const long counts = CascadeCountOffset(files[0]);
-    uint64_t c[4] = {0, 0, 0, 0};
-    for (int i = 0; i < 4; ++i)
-      ASSERT_TRUE(ReadAt(files[0], counts + 8 * i, &c[i]));
-    EXPECT_EQ(c[0], 15u);
-    EXPECT_EQ(c[1], 500u);
-    EXPECT_EQ(c[2], 15u);
-    EXPECT_EQ(c[3], 16u);
-    const long first_split = counts + 32 + 15 * (8 + 500 * 8 + 8 + 500 * 8) + 8;
-    uint32_t idx1 = 0;
-    ASSERT_TRUE(ReadAt(files[0], first_split, &idx1));
-    EXPECT_LT(idx1, 500u);
-    ASSERT_TRUE(WriteAt(files[0], first_split, uint32_t{500}));
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(
-        LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-    p.reset();  // else the process's memo hands the same model back
-    std::unique_ptr<LandmarkPredictor> again;
-    ASSERT_TRUE(
-        LandmarkPredictor::Load(kDefaultShapePredictorPath, &again, dir).ok());
-    EXPECT_TRUE(again->loaded_packed_from_cache());
-  }
-  // A cache in the plain form (dlib's structures, as older versions wrote
-  // it): read, packed, and rewritten in the packed form for the next run.
-  {
-    LandmarkModelKey key;
-    ASSERT_TRUE(StatLandmarkModel(kDefaultShapePredictorPath, &key));
-    {
-      LandmarkPredictor::Impl m;
-      std::ifstream in(kDefaultShapePredictorPath, std::ios::binary);
-      int version = 0;
-      dlib::deserialize(version, in);
-      dlib::deserialize(m.initial_shape, in);
-      dlib::deserialize(m.forests, in);
-      dlib::deserialize(m.anchor_idx, in);
-      dlib::deserialize(m.deltas, in);
-      m.WriteCache(dir, files[0], key);
-    }
-    std::string bytes;
-    ASSERT_TRUE(ReadWholeFile(files[0], &bytes));
-    EXPECT_EQ(bytes.substr(0, 8), "SFLMCAC1");
-    std::vector<Eigen::Vector2d> plain, repacked;
-    {
-      std::unique_ptr<LandmarkPredictor> p;
-      ASSERT_TRUE(
-          LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-      EXPECT_TRUE(p->loaded_from_cache());
-      EXPECT_FALSE(p->loaded_packed_from_cache());
-      ASSERT_TRUE(p->Predict(grey, box, &plain).ok());
-    }
-    ASSERT_TRUE(ReadWholeFile(files[0], &bytes));
-    EXPECT_EQ(bytes.substr(0, 8), "SFLMPAK2");
-    {
-      std::unique_ptr<LandmarkPredictor> p;
-      ASSERT_TRUE(
-          LandmarkPredictor::Load(kDefaultShapePredictorPath, &p, dir).ok());
-      EXPECT_TRUE(p->loaded_packed_from_cache());
-      ASSERT_TRUE(p->Predict(grey, box, &repacked).ok());
-    }
-    ASSERT_EQ(plain.size(), reference.size());
-    ASSERT_EQ(repacked.size(), reference.size());
-    for (size_t i = 0; i < reference.size(); ++i) {
-      EXPECT_EQ(plain[i], reference[i]) << i;
-      EXPECT_EQ(repacked[i], reference[i]) << i;
-    }
-  }
+  ExpectACutCacheIsRewritten(dir, files[0]);
+  ExpectADamagedCountIsRefused(dir, files[0], grey, box, reference);
+  ExpectABadSplitIsRefused(dir, files[0]);
+  ExpectAPlainCacheIsRepacked(dir, files[0], grey, box, reference);
   // An unwritable cache directory is not an error.
-  {
-    std::unique_ptr<LandmarkPredictor> p;
-    ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &p,
-                                        "/proc/steadiface")
-                    .ok());
-    EXPECT_FALSE(p->loaded_from_cache());
-  }
+  EXPECT_FALSE(LoadedFromCache("/proc/steadiface"));
   std::remove(files[0].c_str());
   rmdir(dir.c_str());
   rmdir(dir_template);

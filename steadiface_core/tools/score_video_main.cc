@@ -31,17 +31,11 @@ int main(int argc, char** argv) {
   std::vector<std::string> paths;
   steadiface::CommandLine cl;
   cl.Double("--fps", &fps).String("--name", &name).Positional(&paths);
-  std::string error;
-  const steadiface::CommandLine::Result parsed = cl.Parse(argc, argv, &error);
-  const char* usage = "usage: steadiface_score_video VIDEO [--fps F] [--name LABEL]\n";
-  if (parsed == steadiface::CommandLine::Result::kHelp) {
-    std::cerr << usage;
-    return 0;
-  }
-  if (parsed == steadiface::CommandLine::Result::kError || paths.size() != 1) {
-    if (!error.empty()) std::cerr << "steadiface_score_video: " << error << "\n";
-    std::cerr << usage;
-    return 2;
+  int status = 0;
+  if (!cl.Start(argc, argv, "steadiface_score_video",
+                "usage: steadiface_score_video VIDEO [--fps F] [--name LABEL]\n",
+                [&paths] { return paths.size() == 1; }, std::cout, std::cerr, &status)) {
+    return status;
   }
   const std::string path = paths[0];
   std::unique_ptr<steadiface::eval::VideoScorer> scorer;

@@ -266,6 +266,82 @@ void ExpectRefused(const std::string& path, const std::vector<char>& bytes,
   EXPECT_NE(why.find(reason), std::string::npos) << why;
 }
 
+// Cut anywhere: either refused at Open (the index is at the end) or, if
+// the cut leaves the index, an error while reading.
+void ExpectCutsRefused(const std::vector<char>& bytes, TempDir* dir) {
+  for (size_t cut : {size_t{20}, size_t{4200}, bytes.size() / 2, bytes.size() - 10}) {
+    const std::string path = dir->File("cut.bag");
+    Spill(path, std::vector<char>(bytes.begin(), bytes.begin() + cut));
+    IndexedBagReader reader;
+    std::string why;
+    EXPECT_FALSE(reader.Open(path, &why)) << "cut at " << cut;
+    EXPECT_FALSE(why.empty());
+  }
+}
+
+// An index time out of ros::Time's range (it throws on construction):
+// refused, not thrown. Index entries are the (sec, nsec) pairs of the first
+// stamp not behind a "name=" (message and chunk headers have one).
+void ExpectBadIndexTimeRefused(std::vector<char> bad, TempDir* dir) {
+  const uint32_t sec = 1700000000, nsec = 0;
+  char pattern[8];
+  std::memcpy(pattern, &sec, 4);
+  std::memcpy(pattern + 4, &nsec, 4);
+  size_t hits = 0;
+  for (size_t i = 1; i + 8 <= bad.size(); ++i) {
+    if (bad[i - 1] != '=' && std::memcmp(&bad[i], pattern, 8) == 0) {
+      std::memset(&bad[i], 0xff, 8);
+      ++hits;
+    }
+  }
+  ASSERT_GT(hits, 0u);
+  ExpectRefused(dir->File("bad_time.bag"), bad, "bad index");
+}
+
+// A chunk header stating an uncompressed size its LZ4 data cannot hold
+// (damage): refused at Open, not allocated (4 GB) when the chunk is read.
+void ExpectImpossibleChunkSizeRefused(std::vector<char> bad, TempDir* dir) {
+  const std::string field = "compression=lz4";
+  const auto at = std::search(bad.begin(), bad.end(), field.begin(), field.end());
+  ASSERT_NE(at, bad.end());
+  // The chunk header's next field: <len>"size=" + 4 bytes.
+  const std::string size_field = "size=";
+  const auto sz = std::search(at, bad.end(), size_field.begin(), size_field.end());
+  ASSERT_NE(sz, bad.end());
+  ASSERT_LT(sz - at, 64);
+  const uint32_t huge = 0xfffffff0u;
+  std::memcpy(&*(sz + size_field.size()), &huge, 4);
+  ExpectRefused(dir->File("huge_size.bag"), bad, "impossible size");
+}
+
+// Noise over the first half of the file, which is mostly LZ4 chunk data
+// (pseudo-random images do not compress), in 20 trials: how many ended in
+// an error. Every Next either gives a message within its chunk or stops
+// with an error (nothing past the buffers is read: valgrind shows that too).
+int NoisyTrialsWithErrors(const std::vector<char>& bytes, bool verify, TempDir* dir) {
+  std::mt19937 rng(3);
+  int errors = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<char> noisy = bytes;
+    for (int k = 0; k < 30; ++k) {
+      const size_t at = 4200 + rng() % (noisy.size() / 2);
+      noisy[at] = static_cast<char>(rng());
+    }
+    const std::string path = dir->File("noisy.bag");
+    Spill(path, noisy);
+    IndexedBagReader reader(verify);
+    std::string why;
+    if (!reader.Open(path, &why)) continue;
+    reader.Select({"/imu", "/camera/image_raw", "camera/camera_info"});
+    IndexedBagReader::Message m;
+    std::string error;
+    int n = 0;
+    while (reader.Next(&m, &error) && n < 100000) ++n;
+    if (!error.empty()) ++errors;
+  }
+  return errors;
+}
+
 TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
   TempDir dir;
   const std::string good = dir.File("good.bag");
@@ -274,83 +350,16 @@ TEST(IndexedBagReaderTest, CorruptFilesGiveErrorsNotCrashes) {
            false);
   const std::vector<char> bytes = Slurp(good);
   ASSERT_GT(bytes.size(), 200000u);
-  // Cut anywhere: either refused at Open (the index is at the end) or, if
-  // the cut leaves the index, an error while reading.
-  for (size_t cut :
-       {size_t{20}, size_t{4200}, bytes.size() / 2, bytes.size() - 10}) {
-    const std::string path = dir.File("cut.bag");
-    Spill(path, std::vector<char>(bytes.begin(), bytes.begin() + cut));
-    IndexedBagReader reader;
-    std::string why;
-    EXPECT_FALSE(reader.Open(path, &why)) << "cut at " << cut;
-    EXPECT_FALSE(why.empty());
-  }
-  // An index time out of ros::Time's range (it throws on construction):
-  // refused, not thrown. Index entries are the (sec, nsec) pairs of the
-  // first stamp not behind a "name=" (message and chunk headers have one).
-  {
-    std::vector<char> bad = Slurp(dir.File("small.bag"));
-    const uint32_t sec = 1700000000, nsec = 0;
-    char pattern[8];
-    std::memcpy(pattern, &sec, 4);
-    std::memcpy(pattern + 4, &nsec, 4);
-    size_t hits = 0;
-    for (size_t i = 1; i + 8 <= bad.size(); ++i) {
-      if (bad[i - 1] != '=' && std::memcmp(&bad[i], pattern, 8) == 0) {
-        std::memset(&bad[i], 0xff, 8);
-        ++hits;
-      }
-    }
-    ASSERT_GT(hits, 0u);
-    ExpectRefused(dir.File("bad_time.bag"), bad, "bad index");
-  }
-  // A chunk header stating an uncompressed size its LZ4 data cannot hold
-  // (damage): refused at Open, not allocated (4 GB) when the chunk is read.
-  {
-    std::vector<char> bad = bytes;
-    const std::string field = "compression=lz4";
-    const auto at = std::search(bad.begin(), bad.end(), field.begin(), field.end());
-    ASSERT_NE(at, bad.end());
-    // The chunk header's next field: <len>"size=" + 4 bytes.
-    const std::string size_field = "size=";
-    const auto sz = std::search(at, bad.end(), size_field.begin(), size_field.end());
-    ASSERT_NE(sz, bad.end());
-    ASSERT_LT(sz - at, 64);
-    const uint32_t huge = 0xfffffff0u;
-    std::memcpy(&*(sz + size_field.size()), &huge, 4);
-    ExpectRefused(dir.File("huge_size.bag"), bad, "impossible size");
-  }
-  // Noise over the first half of the file, which is mostly LZ4 chunk data
-  // (pseudo-random images do not compress): every Next either gives a
-  // message within its chunk or stops with an error, and a corrupt chunk
-  // is noticed (nothing past the buffers is read: valgrind shows that too).
-  int errors[2] = {0, 0};  // without, with the checksums
-  for (bool verify : {false, true}) {
-    std::mt19937 rng(3);
-    for (int trial = 0; trial < 20; ++trial) {
-      std::vector<char> noisy = bytes;
-      for (int k = 0; k < 30; ++k) {
-        const size_t at = 4200 + rng() % (noisy.size() / 2);
-        noisy[at] = static_cast<char>(rng());
-      }
-      const std::string path = dir.File("noisy.bag");
-      Spill(path, noisy);
-      IndexedBagReader reader(verify);
-      std::string why;
-      if (!reader.Open(path, &why)) continue;
-      reader.Select({"/imu", "/camera/image_raw", "camera/camera_info"});
-      IndexedBagReader::Message m;
-      std::string error;
-      int n = 0;
-      while (reader.Next(&m, &error) && n < 100000) ++n;
-      if (!error.empty()) ++errors[verify];
-    }
-  }
-  EXPECT_GT(errors[0], 0)
-      << "noise in LZ4 chunks went unnoticed in every trial";
-  // The checksums notice at least whatever the bounds checks notice.
-  EXPECT_GE(errors[1], errors[0]);
-  EXPECT_GT(errors[1], 0);
+  ExpectCutsRefused(bytes, &dir);
+  ExpectBadIndexTimeRefused(Slurp(dir.File("small.bag")), &dir);
+  ExpectImpossibleChunkSizeRefused(bytes, &dir);
+  // A corrupt chunk is noticed; the checksums notice at least whatever the
+  // bounds checks notice.
+  const int without = NoisyTrialsWithErrors(bytes, false, &dir);
+  const int with = NoisyTrialsWithErrors(bytes, true, &dir);
+  EXPECT_GT(without, 0) << "noise in LZ4 chunks went unnoticed in every trial";
+  EXPECT_GE(with, without);
+  EXPECT_GT(with, 0);
 }
 
 TEST(IndexedBagReaderTest, ChunksWhoseTimesMeetAreReadOnce) {

@@ -61,6 +61,72 @@ void ReferenceSample(const WarpMesh& mesh, const cv::Mat& in, cv::Mat* out) {
   }
 }
 
+// What the cases found.
+struct Tally {
+  int cases = 0, failures = 0, applicable = 0;
+  int64_t shuffle_px = 0, total_px = 0;
+};
+
+// Smooth structure plus noise: neighbouring bytes differ.
+cv::Mat TestImage(const cv::Size& size, int cn, uint32_t* state) {
+  cv::Mat img(size, CV_8UC(cn));
+  for (int y = 0; y < img.rows; ++y) {
+    uint8_t* p = img.ptr<uint8_t>(y);
+    for (int x = 0; x < img.cols * cn; ++x) {
+      *state = *state * 1664525u + 1013904223u;
+      p[x] = static_cast<uint8_t>((x * 7 + y * 3) / 2 + ((*state >> 24) & 63));
+    }
+  }
+  return img;
+}
+
+// One affine warp of `img`: the shuffle kernels (kAuto), the portable one
+// and the reference must agree bit for bit; where the kernels apply, they
+// must cover what the geometry allows.
+void CheckCase(const cv::Mat& img, double scale, double angle_deg, bool mirror, float shift,
+               Tally* t) {
+  const cv::Size size = img.size();
+  const int cn = img.channels();
+  const float a = static_cast<float>(angle_deg * M_PI / 180.0);
+  Eigen::Matrix2f A;
+  A << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+  A *= static_cast<float>(scale);
+  if (mirror) A.col(0) *= -1.0f;
+  const Eigen::Vector2f c(0.5f * size.width, 0.5f * size.height);
+  const Eigen::Vector2f b = c - A * c + Eigen::Vector2f(shift * size.width, -shift * size.height);
+  const WarpMesh mesh = AffineMesh(size.width, size.height, 8, A, b);
+  cv::Mat fast, portable, reference;
+  steadiface::SampleStats st;
+  steadiface::SampleMesh(mesh, img, size.width, size.height, &fast,
+                         steadiface::SampleKernel::kAuto, &st);
+  steadiface::SampleMesh(mesh, img, size.width, size.height, &portable,
+                         steadiface::SampleKernel::kPortable);
+  ReferenceSample(mesh, img, &reference);
+  if (cv::norm(fast, portable, cv::NORM_INF) != 0.0 ||
+      cv::norm(fast, reference, cv::NORM_INF) != 0.0) {
+    ++t->failures;
+    std::printf("DIFFERENT: %dx%d channels %d scale %.2f angle %.1f mirror %d shift %.2f\n",
+                size.width, size.height, cn, scale, angle_deg, mirror ? 1 : 0, shift);
+  }
+  t->shuffle_px += st.shuffle_px;
+  t->total_px += size.area();
+  ++t->cases;
+  // Zoom in, small rotation, no border: the kernels' case. A group of g
+  // pixels falls back when it crosses a source row, for (g - 1) scale
+  // |sin(angle)| of groups; 5 % for the edges.
+  if (size.width >= 320 && scale <= 0.85 && std::abs(angle_deg) <= 3.0 && !mirror &&
+      shift == 0.0f) {
+    const int group = cn == 3 ? 4 : 8;
+    const double expected = 1.0 - (group - 1) * scale * std::abs(std::sin(a)) - 0.05;
+    ++t->applicable;
+    if (st.shuffle_px < expected * size.area()) {
+      ++t->failures;
+      std::printf("LOW COVERAGE: channels %d scale %.2f angle %.1f: %.3f < %.3f\n", cn, scale,
+                  angle_deg, static_cast<double>(st.shuffle_px) / size.area(), expected);
+    }
+  }
+}
+
 }  // namespace
 
 int main() {
@@ -69,77 +135,14 @@ int main() {
     return 1;
   }
   uint32_t state = 12345;
-  auto next = [&state]() {
-    state = state * 1664525u + 1013904223u;
-    return static_cast<uint8_t>(state >> 24);
-  };
-  int cases = 0, failures = 0, applicable = 0;
-  int64_t shuffle_px = 0, total_px = 0;
+  Tally t;
   for (const cv::Size size : {cv::Size(320, 240), cv::Size(97, 61)}) {
     for (int cn : {1, 3}) {
-      cv::Mat img(size, CV_8UC(cn));
-      for (int y = 0; y < img.rows; ++y) {
-        uint8_t* p = img.ptr<uint8_t>(y);
-        // Smooth structure plus noise: neighbouring bytes differ.
-        for (int x = 0; x < img.cols * cn; ++x) {
-          p[x] = static_cast<uint8_t>((x * 7 + y * 3) / 2 + (next() & 63));
-        }
-      }
+      const cv::Mat img = TestImage(size, cn, &state);
       for (double scale : {0.7, 0.85, 1.0, 1.3}) {
         for (double angle_deg : {0.0, 0.7, -3.0, 12.0}) {
           for (bool mirror : {false, true}) {
-            for (float shift : {0.0f, -0.3f, 0.25f}) {
-              const float a = static_cast<float>(angle_deg * M_PI / 180.0);
-              Eigen::Matrix2f A;
-              A << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-              A *= static_cast<float>(scale);
-              if (mirror) A.col(0) *= -1.0f;
-              const Eigen::Vector2f c(0.5f * size.width, 0.5f * size.height);
-              const Eigen::Vector2f b =
-                  c - A * c +
-                  Eigen::Vector2f(shift * size.width, -shift * size.height);
-              const WarpMesh mesh = AffineMesh(size.width, size.height, 8, A, b);
-              cv::Mat fast, portable, reference;
-              steadiface::SampleStats st;
-              steadiface::SampleMesh(mesh, img, size.width, size.height,
-                                     &fast, steadiface::SampleKernel::kAuto,
-                                     &st);
-              steadiface::SampleMesh(mesh, img, size.width, size.height,
-                                     &portable,
-                                     steadiface::SampleKernel::kPortable);
-              ReferenceSample(mesh, img, &reference);
-              const bool same =
-                  cv::norm(fast, portable, cv::NORM_INF) == 0.0 &&
-                  cv::norm(fast, reference, cv::NORM_INF) == 0.0;
-              if (!same) {
-                ++failures;
-                std::printf("DIFFERENT: %dx%d channels %d scale %.2f angle "
-                            "%.1f mirror %d shift %.2f\n",
-                            size.width, size.height, cn, scale, angle_deg,
-                            mirror ? 1 : 0, shift);
-              }
-              shuffle_px += st.shuffle_px;
-              total_px += size.area();
-              ++cases;
-              // Zoom in, small rotation, no border: the kernels' case. A
-              // group of g pixels falls back when it crosses a source row,
-              // for (g - 1) scale |sin(angle)| of groups; 5 % for the edges.
-              if (size.width >= 320 && scale <= 0.85 &&
-                  std::abs(angle_deg) <= 3.0 && !mirror && shift == 0.0f) {
-                const int group = cn == 3 ? 4 : 8;
-                const double expected =
-                    1.0 - (group - 1) * scale * std::abs(std::sin(a)) - 0.05;
-                ++applicable;
-                if (st.shuffle_px < expected * size.area()) {
-                  ++failures;
-                  std::printf("LOW COVERAGE: channels %d scale %.2f angle "
-                              "%.1f: %.3f < %.3f\n",
-                              cn, scale, angle_deg,
-                              static_cast<double>(st.shuffle_px) / size.area(),
-                              expected);
-                }
-              }
-            }
+            for (float shift : {0.0f, -0.3f, 0.25f}) CheckCase(img, scale, angle_deg, mirror, shift, &t);
           }
         }
       }
@@ -147,6 +150,6 @@ int main() {
   }
   std::printf("aarch64 check: %d cases, %d failed (%d where the shuffle "
               "kernels apply); they took %.1f%% of all pixels\n",
-              cases, failures, applicable, 100.0 * shuffle_px / total_px);
-  return failures == 0 && applicable == 12 ? 0 : 1;
+              t.cases, t.failures, t.applicable, 100.0 * t.shuffle_px / t.total_px);
+  return t.failures == 0 && t.applicable == 12 ? 0 : 1;
 }

@@ -33,6 +33,34 @@ def quat(x, y, z, w):
 
 
 class EurocTest(unittest.TestCase):
+    def background_through(self, sts, inf, truth):
+        """A far-background direction fixed in the world, in the input (the
+        calibration's K and the true rotation) and through each state's
+        warp into the output (its camera_info's K) [px]."""
+        with open(ARGS.calibration) as f:
+            cal = yaml.safe_load(f)
+        K_in = np.array(cal["camera_matrix"]["data"], dtype=float).reshape(3, 3)
+        d = None
+        b_in, b_out = [], []
+        for s in sts:
+            key = round(s.header.stamp.to_sec(), 3)
+            if key not in truth or key not in inf:
+                continue
+            R_true = truth[key]
+            if d is None:  # a far-background direction fixed in the world
+                d = R_true.T.dot(np.array([0.05, 0.03, 1.0]))
+            p = K_in.dot(R_true.dot(d))
+            p /= p[2]
+            K_out = np.array(inf[key].K).reshape(3, 3)
+            self.assertGreater(K_out[0, 0], 1.2 * K_in[0, 0])  # the 15 % crop, zoomed
+            v, r = s.virtual_rotation, s.real_rotation
+            H = K_out.dot(quat_to_R(v).dot(quat_to_R(r).T)).dot(
+                np.linalg.inv(K_in))
+            q = H.dot(p)
+            b_in.append(p[:2])
+            b_out.append(q[:2] / q[2])
+        return b_in, b_out
+
     def test_euroc_style_bag(self):
         lock = threading.Lock()
         images, infos, states, diag = [], {}, [], {}
@@ -92,28 +120,7 @@ class EurocTest(unittest.TestCase):
         values = {kv.key: kv.value for kv in dg[name[0]].values}
         self.assertEqual(values.get("dropped: bad camera_info"), "0", values)
 
-        with open(ARGS.calibration) as f:
-            cal = yaml.safe_load(f)
-        K_in = np.array(cal["camera_matrix"]["data"], dtype=float).reshape(3, 3)
-        d = None
-        b_in, b_out = [], []
-        for s in sts:
-            key = round(s.header.stamp.to_sec(), 3)
-            if key not in truth or key not in inf:
-                continue
-            R_true = truth[key]
-            if d is None:  # a far-background direction fixed in the world
-                d = R_true.T.dot(np.array([0.05, 0.03, 1.0]))
-            p = K_in.dot(R_true.dot(d))
-            p /= p[2]
-            K_out = np.array(inf[key].K).reshape(3, 3)
-            self.assertGreater(K_out[0, 0], 1.2 * K_in[0, 0])  # the 15 % crop, zoomed
-            v, r = s.virtual_rotation, s.real_rotation
-            H = K_out.dot(quat_to_R(v).dot(quat_to_R(r).T)).dot(
-                np.linalg.inv(K_in))
-            q = H.dot(p)
-            b_in.append(p[:2])
-            b_out.append(q[:2] / q[2])
+        b_in, b_out = self.background_through(sts, inf, truth)
         self.assertGreater(len(b_in), 0.7 * n_frames)
         j_in, j_out = highpass_rms(b_in, 20.0), highpass_rms(b_out, 20.0)
         print("EuRoC-style: %d/%d frames %dx%d mono8; background jitter %.2f -> %.2f px" % (

@@ -219,18 +219,10 @@ class FaultInjectionTest(unittest.TestCase):
                         "%s: good input was not stabilized again (%d -> %d frames out)" % (
                             what, n, self.w.frames_out))
 
-    def test_faults(self):
-        w, p = self.w, self.p
-        # Good input first: frames come out, the face is tracked, gyro OK.
-        p.play(3.0)
-        self.assertTrue(within(lambda: w.frames_out > 30, 3.0), "no stabilized frames from good input")
-        self.assertTrue(within(lambda: w.level("face") == DiagnosticStatus.OK and
-                               "tracking" in w.diag["face"][1], 3.0), w.diag.get("face"))
-        self.assertIn(w.level("gyro"), (DiagnosticStatus.OK, DiagnosticStatus.WARN), w.diag.get("gyro"))
-        results = []
-
+    def check_face_lost(self, results):
         # 1. Face lost: frames without the face (noise); the documented
         #    behaviour is a WARN "face of interest lost" while fading to gyro-only.
+        w, p = self.w, self.p
         rng = np.random.RandomState(1)
         noise = rng.randint(0, 255, size=(270 * 480 * 3,), dtype=np.uint8).tobytes()
 
@@ -248,7 +240,9 @@ class FaultInjectionTest(unittest.TestCase):
         self.expect_recovery("face lost")
         results.append("face lost -> WARN")
 
+    def check_nan_gyro(self, results):
         # 2. NaN and Inf gyro values.
+        w, p = self.w, self.p
         before = self.counter("gyro", "rejected non_finite")
         state = {"n": 0}
 
@@ -265,7 +259,9 @@ class FaultInjectionTest(unittest.TestCase):
         self.expect_recovery("NaN gyro")
         results.append("NaN/Inf gyro")
 
+    def check_imu_order(self, results):
         # 3. Duplicate and out-of-order IMU stamps.
+        w, p = self.w, self.p
         dup_before = self.counter("gyro", "rejected duplicate_stamp")
         ooo_before = self.counter("gyro", "rejected out_of_order")
         def bad_order(m):
@@ -280,7 +276,9 @@ class FaultInjectionTest(unittest.TestCase):
         self.expect_recovery("IMU order")
         results.append("duplicate / out-of-order IMU")
 
+    def check_imu_gap(self, results):
         # 4. An IMU gap of 0.4 s while images continue.
+        w, p = self.w, self.p
         before = self.counter("gyro", "imu gaps")
         p.imu_hook = lambda m: None
         p.play(0.4)
@@ -289,8 +287,10 @@ class FaultInjectionTest(unittest.TestCase):
         self.expect_recovery("IMU gap")
         results.append("IMU gap")
 
+    def check_bad_images(self, results):
         # 5. Bad images: unsupported encoding, zero size, step too small, data
         #    shorter than step*height, size disagreeing with camera_info.
+        w, p = self.w, self.p
         def bad_image(kind):
             def hook(img, info):
                 if kind == "encoding":
@@ -326,7 +326,9 @@ class FaultInjectionTest(unittest.TestCase):
             self.expect_recovery("bad image " + kind)
             results.append("bad image: " + kind)
 
+    def check_resolution_change(self, results):
         # 6. Resolution change mid-stream (a valid half-size stream), then back.
+        w, p = self.w, self.p
         before = self.counter("frames", "geometry rebuilds")
 
         def half(img, info):
@@ -347,6 +349,7 @@ class FaultInjectionTest(unittest.TestCase):
         self.expect_recovery("resolution change")
         results.append("resolution change")
 
+    def check_burst(self, results):
         # 7. A burst of 60 frames at once, ahead of the gyro: bounded queue,
         #    drops or extrapolation counted. The burst starts 0.3 s ahead of
         #    the stream, so no frame of it can be covered by the gyro within
@@ -354,6 +357,7 @@ class FaultInjectionTest(unittest.TestCase):
         #    load (0.002 s ahead, the gyro sometimes arrived in time, the
         #    image subscriber's queue of 5 kept the wrapper's queue of 10 from
         #    overflowing, and nothing was counted).
+        w, p = self.w, self.p
         before_q = self.counter("frames", "dropped: queue full")
         before_x = self.counter("gyro", "frames with extrapolated gyro")
         before_g = self.counter("frames", "dropped: no gyro")
@@ -373,14 +377,34 @@ class FaultInjectionTest(unittest.TestCase):
         self.expect_recovery("burst")
         results.append("burst")
 
+    def check_time_jump(self, results):
         # 8. Time jumps back by 30 s (bag loop / clock reset): reset, then
         #    stabilized again.
+        w, p = self.w, self.p
         before = self.counter("gyro", "time jumps")
         p.jump_back(30.0)
         p.play(0.5)
         self.expect_diag("gyro", "time jumps", before, "time jump back")
         self.expect_recovery("time jump")
         results.append("time jump back")
+
+    def test_faults(self):
+        w, p = self.w, self.p
+        # Good input first: frames come out, the face is tracked, gyro OK.
+        p.play(3.0)
+        self.assertTrue(within(lambda: w.frames_out > 30, 3.0), "no stabilized frames from good input")
+        self.assertTrue(within(lambda: w.level("face") == DiagnosticStatus.OK and
+                               "tracking" in w.diag["face"][1], 3.0), w.diag.get("face"))
+        self.assertIn(w.level("gyro"), (DiagnosticStatus.OK, DiagnosticStatus.WARN), w.diag.get("gyro"))
+        results = []
+        self.check_face_lost(results)
+        self.check_nan_gyro(results)
+        self.check_imu_order(results)
+        self.check_imu_gap(results)
+        self.check_bad_images(results)
+        self.check_resolution_change(results)
+        self.check_burst(results)
+        self.check_time_jump(results)
 
         # Over the whole run: nothing non-finite, and the node still reports.
         self.assertEqual(w.nonfinite, [], "non-finite output: %s" % w.nonfinite[:5])

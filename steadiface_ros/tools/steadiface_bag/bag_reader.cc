@@ -105,95 +105,104 @@ size_t BagReader::ImageCount() const {
       .size();
 }
 
-void BagReader::Start(BoundedQueue<BagItem>* queue) {
-  thread_ = std::thread([this, queue] {
-    std::vector<std::string> topics;
-    for (const std::string& t :
-         {topics_.image, topics_.info, topics_.imu, topics_.landmarks}) {
-      if (t.empty()) continue;
-      for (const auto& v : WithAndWithoutSlash(t)) topics.push_back(v);
+template <typename As>
+bool BagReader::Dispatch(const std::string& raw_topic, const ros::Time& time, As as,
+                         BoundedQueue<BagItem>* queue) {
+  BagItem item;
+  const std::string topic = NormalizeTopic(raw_topic);
+  item.time = time;
+  if (topic == imu_) {
+    item.imu = as(static_cast<sensor_msgs::Imu*>(nullptr));
+  } else if (topic == info_) {
+    item.info = as(static_cast<sensor_msgs::CameraInfo*>(nullptr));
+  } else if (topic == landmarks_) {
+    item.landmarks = as(static_cast<steadiface::FaceLandmarks*>(nullptr));
+  } else if (topic == image_ && !compressed_) {
+    item.image = as(static_cast<sensor_msgs::Image*>(nullptr));
+  } else if (topic == image_) {
+    sensor_msgs::CompressedImageConstPtr c =
+        as(static_cast<sensor_msgs::CompressedImage*>(nullptr));
+    sensor_msgs::ImagePtr decoded;
+    const steadiface::Status s =
+        c ? steadiface_ros::FromCompressedImage(*c, &decoded)
+          : steadiface::Status::Error("not a sensor_msgs/CompressedImage");
+    if (s.ok()) {
+      item.image = decoded;
+    } else if (decode_failures_++ == 0) {
+      std::cerr << "steadiface_bag: " << s.message() << " (frame skipped)\n";
     }
-    const std::string imu = NormalizeTopic(topics_.imu),
-                      info = NormalizeTopic(topics_.info),
-                      landmarks = NormalizeTopic(topics_.landmarks),
-                      image = NormalizeTopic(topics_.image);
-    // One message of `raw_topic` at `time`; `as(static_cast<M*>(nullptr))`
-    // gives it as an M (null if it is not one). False when the queue is
-    // closed.
-    auto dispatch = [&](const std::string& raw_topic, const ros::Time& time,
-                        auto as) -> bool {
-      BagItem item;
-      const std::string topic = NormalizeTopic(raw_topic);
-      item.time = time;
-      if (topic == imu) {
-        item.imu = as(static_cast<sensor_msgs::Imu*>(nullptr));
-      } else if (topic == info) {
-        item.info = as(static_cast<sensor_msgs::CameraInfo*>(nullptr));
-      } else if (topic == landmarks) {
-        item.landmarks = as(static_cast<steadiface::FaceLandmarks*>(nullptr));
-      } else if (topic == image && !compressed_) {
-        item.image = as(static_cast<sensor_msgs::Image*>(nullptr));
-      } else if (topic == image) {
-        sensor_msgs::CompressedImageConstPtr c =
-            as(static_cast<sensor_msgs::CompressedImage*>(nullptr));
-        sensor_msgs::ImagePtr decoded;
-        const steadiface::Status s =
-            c ? steadiface_ros::FromCompressedImage(*c, &decoded)
-              : steadiface::Status::Error("not a sensor_msgs/CompressedImage");
-        if (s.ok()) {
-          item.image = decoded;
-        } else if (decode_failures_++ == 0) {
-          std::cerr << "steadiface_bag: " << s.message() << " (frame skipped)\n";
-        }
+  }
+  return queue->Push(std::move(item));
+}
+
+void BagReader::ReadIndexed(const std::vector<std::string>& topics,
+                            BoundedQueue<BagItem>* queue) {
+  fast_->Select(topics);
+  IndexedBagReader::Message m;
+  std::string err;
+  while (fast_->Next(&m, &err)) {
+    const std::string& topic = fast_->connections().at(m.connection).topic;
+    const std::string& datatype = fast_->connections().at(m.connection).datatype;
+    auto as = [this, &m, &topic, &datatype](auto* type) {
+      using M = std::remove_pointer_t<decltype(type)>;
+      // As MessageInstance::instantiate: null for another type.
+      if (datatype != ros::message_traits::datatype<M>()) {
+        return boost::shared_ptr<const M>();
       }
-      return queue->Push(std::move(item));
+      boost::shared_ptr<M> msg(new M);
+      try {
+        ros::serialization::IStream s(const_cast<uint8_t*>(m.data), m.size);
+        ros::serialization::deserialize(s, *msg);
+      } catch (const ros::Exception& e) {
+        // A damaged message (rosbag::View would stop the whole read).
+        if (decode_failures_++ == 0) {
+          std::cerr << "steadiface_bag: a message on " << topic
+                    << " does not deserialize (" << e.what() << "; skipped)\n";
+        }
+        msg.reset();
+      }
+      return boost::shared_ptr<const M>(msg);
     };
-    try {
-      if (fast_) {
-        fast_->Select(topics);
-        IndexedBagReader::Message m;
-        std::string err;
-        while (fast_->Next(&m, &err)) {
-          const std::string& topic = fast_->connections().at(m.connection).topic;
-          const std::string& datatype = fast_->connections().at(m.connection).datatype;
-          auto as = [this, &m, &topic, &datatype](auto* type) {
-            using M = std::remove_pointer_t<decltype(type)>;
-            // As MessageInstance::instantiate: null for another type.
-            if (datatype != ros::message_traits::datatype<M>()) {
-              return boost::shared_ptr<const M>();
-            }
-            boost::shared_ptr<M> msg(new M);
-            try {
-              ros::serialization::IStream s(const_cast<uint8_t*>(m.data), m.size);
-              ros::serialization::deserialize(s, *msg);
-            } catch (const ros::Exception& e) {
-              // A damaged message (rosbag::View would stop the whole read).
-              if (decode_failures_++ == 0) {
-                std::cerr << "steadiface_bag: a message on " << topic
-                          << " does not deserialize (" << e.what() << "; skipped)\n";
-              }
-              msg.reset();
-            }
-            return boost::shared_ptr<const M>(msg);
-          };
-          if (!dispatch(topic, m.time, as)) break;
-        }
-        if (!err.empty()) error_ = err;
-      } else if (bag_) {
-        rosbag::View view(*bag_, rosbag::TopicQuery(topics));
-        for (const rosbag::MessageInstance& m : view) {
-          auto as = [&m](auto* type) {
-            using M = std::remove_pointer_t<decltype(type)>;
-            return boost::shared_ptr<const M>(m.instantiate<M>());
-          };
-          if (!dispatch(m.getTopic(), m.getTime(), as)) break;
-        }
-      }
-    } catch (const std::exception& e) {
-      error_ = e.what();
+    if (!Dispatch(topic, m.time, as, queue)) break;
+  }
+  if (!err.empty()) error_ = err;
+}
+
+void BagReader::ReadView(const std::vector<std::string>& topics, BoundedQueue<BagItem>* queue) {
+  rosbag::View view(*bag_, rosbag::TopicQuery(topics));
+  for (const rosbag::MessageInstance& m : view) {
+    auto as = [&m](auto* type) {
+      using M = std::remove_pointer_t<decltype(type)>;
+      return boost::shared_ptr<const M>(m.instantiate<M>());
+    };
+    if (!Dispatch(m.getTopic(), m.getTime(), as, queue)) break;
+  }
+}
+
+void BagReader::ReadAll(BoundedQueue<BagItem>* queue) {
+  std::vector<std::string> topics;
+  for (const std::string& t : {topics_.image, topics_.info, topics_.imu, topics_.landmarks}) {
+    if (t.empty()) continue;
+    for (const auto& v : WithAndWithoutSlash(t)) topics.push_back(v);
+  }
+  imu_ = NormalizeTopic(topics_.imu);
+  info_ = NormalizeTopic(topics_.info);
+  landmarks_ = NormalizeTopic(topics_.landmarks);
+  image_ = NormalizeTopic(topics_.image);
+  try {
+    if (fast_) {
+      ReadIndexed(topics, queue);
+    } else if (bag_) {
+      ReadView(topics, queue);
     }
-    queue->Close();
-  });
+  } catch (const std::exception& e) {
+    error_ = e.what();
+  }
+  queue->Close();
+}
+
+void BagReader::Start(BoundedQueue<BagItem>* queue) {
+  thread_ = std::thread([this, queue] { ReadAll(queue); });
 }
 
 std::string BagReader::Join() {

@@ -89,6 +89,16 @@ class BagReader {
 
  private:
   std::vector<std::string> WithAndWithoutSlash(const std::string& t) const;
+  // The reader thread's work: every message of the topics, in bag order,
+  // through the indexed reader or rosbag::View.
+  void ReadAll(BoundedQueue<BagItem>* queue);
+  void ReadIndexed(const std::vector<std::string>& topics, BoundedQueue<BagItem>* queue);
+  void ReadView(const std::vector<std::string>& topics, BoundedQueue<BagItem>* queue);
+  // One message of `raw_topic` at `time` into the queue; `as(static_cast<M*>(nullptr))`
+  // gives it as an M (null if it is not one). False when the queue is closed.
+  template <typename As>
+  bool Dispatch(const std::string& raw_topic, const ros::Time& time, As as,
+                BoundedQueue<BagItem>* queue);
 
   const std::string path_;
   const BagTopics topics_;
@@ -101,6 +111,8 @@ class BagReader {
   size_t decode_failures_ = 0;  // written by the reader thread, read after join
   std::thread thread_;
   std::string error_;  // written by the reader thread, read after join
+  // The topics' normalized names (NormalizeTopic), set by ReadAll.
+  std::string imu_, info_, landmarks_, image_;
 };
 
 }  // namespace steadiface_bag

@@ -86,95 +86,94 @@ std::string TruthJson(const ReportInputs& r, const BagSink& sink) {
 
 }  // namespace
 
-std::string MakeReport(const ReportInputs& r, const BagSink& sink,
-                       const steadiface_ros::WrapperStatus& ws) {
-  // Report: what can be measured without ground truth.
+namespace {
+
+// What the report measures from the states alone: per-frame timings, the
+// face's and the target's centres, the residual rotation, the face losses.
+struct StateSeries {
   std::vector<double> face_ms, stab_ms, warp_ms, total_ms, solver_ms, iters;
   std::vector<Eigen::Vector2d> c_in, c_out, shake;
   // Frames without valid landmarks while a face was locked, by reason.
   std::map<std::string, int> face_losses;
-  for (size_t i = 0; i < sink.states.size(); ++i) {
-    const auto& s = sink.states[i];
-    if (s.face_state == 2 /* LOST */) ++face_losses[s.face_failure];
-    face_ms.push_back(s.face_ms);
-    stab_ms.push_back(s.stabilizer_ms);
-    warp_ms.push_back(s.warp_ms);
-    total_ms.push_back(s.total_ms);
-    solver_ms.push_back(s.solver_time_ms);
-    iters.push_back(s.solver_iterations);
+  double fps = 30.0;  // of the data
+};
+
+StateSeries Series(const BagSink& sink) {
+  StateSeries t;
+  for (const auto& s : sink.states) {
+    if (s.face_state == 2 /* LOST */) ++t.face_losses[s.face_failure];
+    t.face_ms.push_back(s.face_ms);
+    t.stab_ms.push_back(s.stabilizer_ms);
+    t.warp_ms.push_back(s.warp_ms);
+    t.total_ms.push_back(s.total_ms);
+    t.solver_ms.push_back(s.solver_time_ms);
+    t.iters.push_back(s.solver_iterations);
     // Residual camera shake: virtual rotation vector (what the viewer sees
     // of the camera's rotation).
     Eigen::Quaterniond q;
     steadiface_ros::ToEigen(s.virtual_rotation, &q);
     const Eigen::Vector3d v = steadiface::LogSO3(q);
-    shake.emplace_back(v.x(), v.y());
+    t.shake.emplace_back(v.x(), v.y());
     if (s.has_target) {
-      c_in.emplace_back(s.centre_c[0], s.centre_c[1]);
-      c_out.emplace_back(s.target_h[0], s.target_h[1]);
+      t.c_in.emplace_back(s.centre_c[0], s.centre_c[1]);
+      t.c_out.emplace_back(s.target_h[0], s.target_h[1]);
     }
   }
-  double fps_data = 30.0;
   if (sink.states.size() > 2) {
-    fps_data = (sink.states.size() - 1) /
-               std::max(1e-9, (sink.states.back().header.stamp -
-                               sink.states.front().header.stamp)
-                                  .toSec());
+    t.fps = (sink.states.size() - 1) /
+            std::max(1e-9, (sink.states.back().header.stamp -
+                            sink.states.front().header.stamp)
+                               .toSec());
   }
-  const std::string truth_json = r.scorer ? TruthJson(r, sink) : std::string();
-  // The gyro-vs-video check as of the last frame.
-  std::string check_json;
-  if (!sink.states.empty()) {
-    const auto& s = sink.states.back();
-    std::ostringstream cj;
-    cj << ",\n  \"gyro_video_check\": {\"judged\": "
-       << (s.check_judged ? "true" : "false")
-       << ", \"motion_px\": " << s.check_motion_px
-       << ", \"residual_px\": " << s.check_residual_px
-       << ", \"best_mounting_residual_px\": "
-       << s.check_best_mounting_residual_px
-       << ", \"imu_rotation_contradicts\": "
-       << (s.imu_rotation_contradicts ? "true" : "false")
-       << ", \"suggested_R_cam_imu\": [" << s.suggested_R_cam_imu.x << ", "
-       << s.suggested_R_cam_imu.y << ", " << s.suggested_R_cam_imu.z << ", "
-       << s.suggested_R_cam_imu.w << "]"
-       << ", \"imu_offset_correction_s\": " << s.imu_offset_correction_s
-       << ", \"imu_offset_off\": " << (s.imu_offset_off ? "true" : "false")
-       << ", \"imu_offset_applied_s\": " << s.imu_offset_applied_s << "}";
-    check_json = cj.str();
-    if (s.imu_rotation_contradicts) {
-      std::cerr << "steadiface_bag: WARNING: imu/R_cam_imu contradicts the "
-                   "video (residual "
-                << s.check_residual_px << " px; the axis permutation ["
-                << s.suggested_R_cam_imu.x << ", " << s.suggested_R_cam_imu.y
-                << ", " << s.suggested_R_cam_imu.z << ", "
-                << s.suggested_R_cam_imu.w << "] explains it to "
-                << s.check_best_mounting_residual_px
-                << " px): set imu/R_cam_imu, and add "
-                << s.imu_offset_correction_s * 1e3
-                << " ms to imu/time_offset\n";
-    } else if (s.imu_offset_off) {
-      std::cerr << "steadiface_bag: WARNING: imu/time_offset is off by "
-                << s.imu_offset_correction_s * 1e3
-                << " ms (add it to imu/time_offset; "
-                << s.imu_offset_applied_s * 1e3
-                << " ms was applied by the last frame, "
-                   "gyro_video_check/apply_offset)\n";
-    }
+  return t;
+}
+
+// The gyro-vs-video check as of the last frame (and its warnings on
+// stderr); empty without frames.
+std::string CheckJson(const BagSink& sink) {
+  if (sink.states.empty()) return std::string();
+  const auto& s = sink.states.back();
+  std::ostringstream cj;
+  cj << ",\n  \"gyro_video_check\": {\"judged\": "
+     << (s.check_judged ? "true" : "false")
+     << ", \"motion_px\": " << s.check_motion_px
+     << ", \"residual_px\": " << s.check_residual_px
+     << ", \"best_mounting_residual_px\": "
+     << s.check_best_mounting_residual_px
+     << ", \"imu_rotation_contradicts\": "
+     << (s.imu_rotation_contradicts ? "true" : "false")
+     << ", \"suggested_R_cam_imu\": [" << s.suggested_R_cam_imu.x << ", "
+     << s.suggested_R_cam_imu.y << ", " << s.suggested_R_cam_imu.z << ", "
+     << s.suggested_R_cam_imu.w << "]"
+     << ", \"imu_offset_correction_s\": " << s.imu_offset_correction_s
+     << ", \"imu_offset_off\": " << (s.imu_offset_off ? "true" : "false")
+     << ", \"imu_offset_applied_s\": " << s.imu_offset_applied_s << "}";
+  if (s.imu_rotation_contradicts) {
+    std::cerr << "steadiface_bag: WARNING: imu/R_cam_imu contradicts the "
+                 "video (residual "
+              << s.check_residual_px << " px; the axis permutation ["
+              << s.suggested_R_cam_imu.x << ", " << s.suggested_R_cam_imu.y
+              << ", " << s.suggested_R_cam_imu.z << ", "
+              << s.suggested_R_cam_imu.w << "] explains it to "
+              << s.check_best_mounting_residual_px
+              << " px): set imu/R_cam_imu, and add "
+              << s.imu_offset_correction_s * 1e3
+              << " ms to imu/time_offset\n";
+  } else if (s.imu_offset_off) {
+    std::cerr << "steadiface_bag: WARNING: imu/time_offset is off by "
+              << s.imu_offset_correction_s * 1e3
+              << " ms (add it to imu/time_offset; "
+              << s.imu_offset_applied_s * 1e3
+              << " ms was applied by the last frame, "
+                 "gyro_video_check/apply_offset)\n";
   }
-  std::ostringstream rep;
-  rep.precision(6);
-  rep << "{\n  \"input\": \"" << r.in
-      << "\",\n  \"frames_in\": " << ws.counters.images_in
-      << ",\n  \"frames_out\": " << ws.counters.frames_out
-      << ",\n  \"wall_time_s\": " << r.elapsed_s << ",\n  \"throughput_fps\": "
-      << ws.counters.frames_out / std::max(r.elapsed_s, 1e-9)
-      << ",\n  \"landmark_centre_jitter_in_norm\": "
-      << HighPassRms(c_in, fps_data, 0.5) << ",\n  \"target_jitter_out_norm\": "
-      << HighPassRms(c_out, fps_data, 0.5)
-      << ",\n  \"residual_rotation_jitter_rad\": "
-      << HighPassRms(shake, fps_data, 0.5)
-      << ",\n  \"crop_ratio\": " << r.crop_ratio
-      << ",\n  \"dropped\": {\"bad_image\": " << ws.counters.dropped_bad_image
+  return cj.str();
+}
+
+// The wrapper's counters, from "dropped" to "face_lost_frames_by_reason".
+void CountersJson(const steadiface_ros::WrapperStatus& ws, const StateSeries& t,
+                  std::ostream& rep) {
+  rep << ",\n  \"dropped\": {\"bad_image\": " << ws.counters.dropped_bad_image
       << ", \"bad_info\": " << ws.counters.dropped_bad_info
       << ", \"no_gyro\": " << ws.counters.dropped_no_gyro
       << ", \"queue_full\": " << ws.counters.dropped_queue_full
@@ -191,24 +190,52 @@ std::string MakeReport(const ReportInputs& r, const BagSink& sink,
       << ",\n  \"frames_with_face\": " << ws.stabilizer.frames_with_face
       << ",\n  \"face_lost_frames_by_reason\": {";
   bool first_reason = true;
-  for (const auto& kv : face_losses) {
+  for (const auto& kv : t.face_losses) {
     rep << (first_reason ? "" : ", ") << "\"" << kv.first << "\": " << kv.second;
     first_reason = false;
   }
-  rep << "}"
-      << ",\n  \"timings_ms\": {"
-      << "\"face\": [" << Percentile(face_ms, 0.5) << ", "
-      << Percentile(face_ms, 0.99) << "], "
-      << "\"stabilizer\": [" << Percentile(stab_ms, 0.5) << ", "
-      << Percentile(stab_ms, 0.99) << "], "
-      << "\"solver\": [" << Percentile(solver_ms, 0.5) << ", "
-      << Percentile(solver_ms, 0.99) << "], "
-      << "\"warp\": [" << Percentile(warp_ms, 0.5) << ", "
-      << Percentile(warp_ms, 0.99) << "], "
-      << "\"total\": [" << Percentile(total_ms, 0.5) << ", "
-      << Percentile(total_ms, 0.99) << "]}"
-      << ",\n  \"solver_iterations_median\": " << Percentile(iters, 0.5)
-      << check_json << truth_json << ",\n  \"method\": \""
+  rep << "}";
+}
+
+void TimingsJson(const StateSeries& t, std::ostream& rep) {
+  rep << ",\n  \"timings_ms\": {"
+      << "\"face\": [" << Percentile(t.face_ms, 0.5) << ", "
+      << Percentile(t.face_ms, 0.99) << "], "
+      << "\"stabilizer\": [" << Percentile(t.stab_ms, 0.5) << ", "
+      << Percentile(t.stab_ms, 0.99) << "], "
+      << "\"solver\": [" << Percentile(t.solver_ms, 0.5) << ", "
+      << Percentile(t.solver_ms, 0.99) << "], "
+      << "\"warp\": [" << Percentile(t.warp_ms, 0.5) << ", "
+      << Percentile(t.warp_ms, 0.99) << "], "
+      << "\"total\": [" << Percentile(t.total_ms, 0.5) << ", "
+      << Percentile(t.total_ms, 0.99) << "]}"
+      << ",\n  \"solver_iterations_median\": " << Percentile(t.iters, 0.5);
+}
+
+}  // namespace
+
+std::string MakeReport(const ReportInputs& r, const BagSink& sink,
+                       const steadiface_ros::WrapperStatus& ws) {
+  // Report: what can be measured without ground truth.
+  const StateSeries t = Series(sink);
+  const std::string truth_json = r.scorer ? TruthJson(r, sink) : std::string();
+  const std::string check_json = CheckJson(sink);
+  std::ostringstream rep;
+  rep.precision(6);
+  rep << "{\n  \"input\": \"" << r.in
+      << "\",\n  \"frames_in\": " << ws.counters.images_in
+      << ",\n  \"frames_out\": " << ws.counters.frames_out
+      << ",\n  \"wall_time_s\": " << r.elapsed_s << ",\n  \"throughput_fps\": "
+      << ws.counters.frames_out / std::max(r.elapsed_s, 1e-9)
+      << ",\n  \"landmark_centre_jitter_in_norm\": "
+      << HighPassRms(t.c_in, t.fps, 0.5) << ",\n  \"target_jitter_out_norm\": "
+      << HighPassRms(t.c_out, t.fps, 0.5)
+      << ",\n  \"residual_rotation_jitter_rad\": "
+      << HighPassRms(t.shake, t.fps, 0.5)
+      << ",\n  \"crop_ratio\": " << r.crop_ratio;
+  CountersJson(ws, t, rep);
+  TimingsJson(t, rep);
+  rep << check_json << truth_json << ",\n  \"method\": \""
       << MethodName(r, sink) << "\"\n}\n";
   return rep.str();
 }

@@ -212,7 +212,8 @@ bool IndexedBagReader::ReadAt(uint64_t offset, uint32_t size, uint8_t* out,
   return true;
 }
 
-bool IndexedBagReader::ReadIndex(std::string* why) {
+bool IndexedBagReader::ReadFileHeader(std::string* why, uint64_t* index_pos,
+                                      uint32_t* conn_count, uint32_t* chunk_count) {
   const size_t vlen = sizeof(kVersionLine) - 1;
   if (file_size_ < vlen || std::memcmp(file_, kVersionLine, vlen) != 0) {
     *why = "not a version 2.0 bag";
@@ -225,11 +226,9 @@ bool IndexedBagReader::ReadIndex(std::string* why) {
     *why = "no bag header record";
     return false;
   }
-  uint64_t index_pos = 0;
-  uint32_t conn_count = 0, chunk_count = 0;
-  if (!r.Uint64("index_pos", &index_pos) ||
-      !r.Uint32("conn_count", &conn_count) ||
-      !r.Uint32("chunk_count", &chunk_count)) {
+  if (!r.Uint64("index_pos", index_pos) ||
+      !r.Uint32("conn_count", conn_count) ||
+      !r.Uint32("chunk_count", chunk_count)) {
     *why = "bag header without index_pos/conn_count/chunk_count";
     return false;
   }
@@ -239,17 +238,21 @@ bool IndexedBagReader::ReadIndex(std::string* why) {
     *why = "encrypted bag (" + encryptor + ")";
     return false;
   }
-  if (index_pos == 0 || index_pos >= file_size_) {
+  if (*index_pos == 0 || *index_pos >= file_size_) {
     *why = "unindexed bag (rosbag reindex it)";
     return false;
   }
-  // Connection records, then chunk info records, at index_pos.
-  uint64_t pos = index_pos;
-  for (uint32_t i = 0; i < conn_count; ++i) {
+  return true;
+}
+
+bool IndexedBagReader::ReadConnections(uint32_t count, uint64_t* pos, std::string* why) {
+  Record r;
+  uint8_t op = 0;
+  for (uint32_t i = 0; i < count; ++i) {
     uint32_t id = 0;
     Connection c;
     std::map<std::string, std::string> conn_header;
-    if (!ParseRecord(file_, file_size_, pos, &r) || !r.Op(&op) ||
+    if (!ParseRecord(file_, file_size_, *pos, &r) || !r.Op(&op) ||
         op != kOpConnection || !r.Uint32("conn", &id) ||
         !r.String("topic", &c.topic) ||
         !ParseFields(r.data, r.data_size, &conn_header)) {
@@ -259,76 +262,103 @@ bool IndexedBagReader::ReadIndex(std::string* why) {
     auto type = conn_header.find("type");
     if (type != conn_header.end()) c.datatype = type->second;
     connections_[id] = c;
-    pos += r.total_size;
+    *pos += r.total_size;
   }
-  std::vector<std::pair<uint64_t, uint32_t>>
-      chunk_infos;  // position, connections
-  for (uint32_t i = 0; i < chunk_count; ++i) {
+  return true;
+}
+
+bool IndexedBagReader::ReadChunkInfos(uint32_t count, uint64_t* pos,
+                                      std::vector<std::pair<uint64_t, uint32_t>>* chunk_infos,
+                                      std::string* why) {
+  Record r;
+  uint8_t op = 0;
+  for (uint32_t i = 0; i < count; ++i) {
     uint64_t chunk_pos = 0;
-    uint32_t count = 0;
-    if (!ParseRecord(file_, file_size_, pos, &r) || !r.Op(&op) ||
+    uint32_t connections = 0;
+    if (!ParseRecord(file_, file_size_, *pos, &r) || !r.Op(&op) ||
         op != kOpChunkInfo || !r.Uint64("chunk_pos", &chunk_pos) ||
-        !r.Uint32("count", &count)) {
+        !r.Uint32("count", &connections)) {
       *why = "bad chunk info record in the index";
       return false;
     }
-    chunk_infos.emplace_back(chunk_pos, count);
-    pos += r.total_size;
+    chunk_infos->emplace_back(chunk_pos, connections);
+    *pos += r.total_size;
+  }
+  return true;
+}
+
+bool IndexedBagReader::ReadChunk(uint64_t chunk_pos, uint32_t connections, std::string* why) {
+  Record r;
+  uint8_t op = 0;
+  Chunk chunk;
+  if (!ParseRecord(file_, file_size_, chunk_pos, &r) || !r.Op(&op) ||
+      op != kOpChunk || !r.String("compression", &chunk.compression) ||
+      !r.Uint32("size", &chunk.size)) {
+    *why = "bad chunk record";
+    return false;
+  }
+  if (chunk.compression != "none" && chunk.compression != "lz4") {
+    *why = "chunks compressed with " + chunk.compression;
+    return false;
+  }
+  chunk.data_offset = static_cast<uint64_t>(r.data - file_);
+  chunk.stored_size = r.data_size;
+  if (chunk.compression == "none" && chunk.size != chunk.stored_size) {
+    *why = "uncompressed chunk of the wrong size";
+    return false;
+  }
+  // LZ4 expands at most 255-fold (a match's length costs at least one byte
+  // per 255): a larger stated size is damage, refused here rather than
+  // allocated and cleared when the chunk is read.
+  if (chunk.compression == "lz4" &&
+      chunk.size > 255ull * chunk.stored_size + 65536) {
+    *why = "LZ4 chunk states an impossible size";
+    return false;
+  }
+  uint64_t q = chunk_pos + r.total_size;
+  for (uint32_t k = 0; k < connections; ++k) {
+    uint32_t ver = 0, conn = 0, count = 0;
+    if (!ParseRecord(file_, file_size_, q, &r) || !r.Op(&op) ||
+        op != kOpIndexData || !r.Uint32("ver", &ver) || ver != 1 ||
+        !r.Uint32("conn", &conn) || !r.Uint32("count", &count) ||
+        r.data_size / 12 < count) {
+      *why = "bad connection index record";
+      return false;
+    }
+    Index& index = indexes_[conn];
+    for (uint32_t e = 0; e < count; ++e) {
+      const uint8_t* p = r.data + 12ull * e;
+      IndexEntry entry;
+      entry.time = ros::Time(U32(p), U32(p + 4));
+      entry.chunk_pos = chunk_pos;
+      entry.offset = U32(p + 8);
+      if (entry.offset >= chunk.size) {
+        *why = "index entry outside its chunk";
+        return false;
+      }
+      index.insert(index.end(), entry);
+    }
+    q += r.total_size;
+  }
+  chunks_[chunk_pos] = chunk;
+  return true;
+}
+
+bool IndexedBagReader::ReadIndex(std::string* why) {
+  uint64_t index_pos = 0;
+  uint32_t conn_count = 0, chunk_count = 0;
+  if (!ReadFileHeader(why, &index_pos, &conn_count, &chunk_count)) return false;
+  // Connection records, then chunk info records, at index_pos.
+  uint64_t pos = index_pos;
+  std::vector<std::pair<uint64_t, uint32_t>> chunk_infos;  // position, connections
+  if (!ReadConnections(conn_count, &pos, why) ||
+      !ReadChunkInfos(chunk_count, &pos, &chunk_infos, why)) {
+    return false;
   }
   // Each chunk, and the connection index records right after it: one
   // multiset per connection, filled in chunk order as rosbag does.
   for (const auto& ci : chunk_infos) {
-    Chunk chunk;
-    if (!ParseRecord(file_, file_size_, ci.first, &r) || !r.Op(&op) ||
-        op != kOpChunk || !r.String("compression", &chunk.compression) ||
-        !r.Uint32("size", &chunk.size)) {
-      *why = "bad chunk record";
-      return false;
-    }
-    if (chunk.compression != "none" && chunk.compression != "lz4") {
-      *why = "chunks compressed with " + chunk.compression;
-      return false;
-    }
-    chunk.data_offset = static_cast<uint64_t>(r.data - file_);
-    chunk.stored_size = r.data_size;
-    if (chunk.compression == "none" && chunk.size != chunk.stored_size) {
-      *why = "uncompressed chunk of the wrong size";
-      return false;
-    }
-    // LZ4 expands at most 255-fold (a match's length costs at least one byte
-    // per 255): a larger stated size is damage, refused here rather than
-    // allocated and cleared when the chunk is read.
-    if (chunk.compression == "lz4" &&
-        chunk.size > 255ull * chunk.stored_size + 65536) {
-      *why = "LZ4 chunk states an impossible size";
-      return false;
-    }
-    uint64_t q = ci.first + r.total_size;
-    for (uint32_t k = 0; k < ci.second; ++k) {
-      uint32_t ver = 0, conn = 0, count = 0;
-      if (!ParseRecord(file_, file_size_, q, &r) || !r.Op(&op) ||
-          op != kOpIndexData || !r.Uint32("ver", &ver) || ver != 1 ||
-          !r.Uint32("conn", &conn) || !r.Uint32("count", &count) ||
-          r.data_size / 12 < count) {
-        *why = "bad connection index record";
-        return false;
-      }
-      Index& index = indexes_[conn];
-      for (uint32_t e = 0; e < count; ++e) {
-        const uint8_t* p = r.data + 12ull * e;
-        IndexEntry entry;
-        entry.time = ros::Time(U32(p), U32(p + 4));
-        entry.chunk_pos = ci.first;
-        entry.offset = U32(p + 8);
-        if (entry.offset >= chunk.size) {
-          *why = "index entry outside its chunk";
-          return false;
-        }
-        index.insert(index.end(), entry);
-      }
-      q += r.total_size;
-    }
-    chunks_[ci.first] = chunk;
+    if (!ReadChunk(ci.first, ci.second, why)) return false;
   }
   return true;
 }

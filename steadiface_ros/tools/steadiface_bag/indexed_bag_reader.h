@@ -108,6 +108,15 @@ class IndexedBagReader {
   };
 
   bool ReadIndex(std::string* why);
+  // ReadIndex's steps: the file header (where the index is, what it
+  // holds), the connection records and chunk infos from *pos on, and one
+  // chunk with its connection index records.
+  bool ReadFileHeader(std::string* why, uint64_t* index_pos, uint32_t* conn_count,
+                      uint32_t* chunk_count);
+  bool ReadConnections(uint32_t count, uint64_t* pos, std::string* why);
+  bool ReadChunkInfos(uint32_t count, uint64_t* pos,
+                      std::vector<std::pair<uint64_t, uint32_t>>* chunk_infos, std::string* why);
+  bool ReadChunk(uint64_t chunk_pos, uint32_t connections, std::string* why);
   /// The chunk at `pos`'s records, read and decompressed; null with
   /// *error on failure.
   const uint8_t* ChunkData(uint64_t pos, uint32_t* size, std::string* error);
