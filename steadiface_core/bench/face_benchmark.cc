@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -48,16 +49,23 @@ void Args(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h"})->Unit(benchmark::kMillisecond);
 }
 
-void BM_FaceTracking(benchmark::State& state) {
-  const Scene s = Make(state.range(0), state.range(1));
-  FaceTrackerOptions o;
-  o.redetect_every_frames = 10000;  // pure tracking
+// The tracker for `s`; null (and the benchmark skipped) when it cannot be made.
+std::unique_ptr<FaceTracker> MakeTracker(const Scene& s, const FaceTrackerOptions& o,
+                                         benchmark::State& state) {
   std::unique_ptr<FaceTracker> t;
   const Status st = FaceTracker::Create(s.model, o, &t);
   if (!st.ok() || s.frame.empty()) {
     state.SkipWithError(st.ok() ? "no test frame" : st.message().c_str());
-    return;
+    return nullptr;
   }
+  return t;
+}
+
+// The face acquired on the first frame, then tracked at 30 fps.
+void TrackAt30Fps(benchmark::State& state, const FaceTrackerOptions& o) {
+  const Scene s = Make(state.range(0), state.range(1));
+  const std::unique_ptr<FaceTracker> t = MakeTracker(s, o, state);
+  if (!t) return;
   FaceInfo fi;
   double time = 1.0;
   t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);  // acquire
@@ -69,14 +77,16 @@ void BM_FaceTracking(benchmark::State& state) {
   state.counters["detected"] = fi.detected;
 }
 
+void BM_FaceTracking(benchmark::State& state) {
+  FaceTrackerOptions o;
+  o.redetect_every_frames = 10000;  // pure tracking
+  TrackAt30Fps(state, o);
+}
+
 void BM_FaceDetectionMode(benchmark::State& state) {
   const Scene s = Make(state.range(0), state.range(1));
-  std::unique_ptr<FaceTracker> t;
-  const Status st = FaceTracker::Create(s.model, FaceTrackerOptions(), &t);
-  if (!st.ok() || s.frame.empty()) {
-    state.SkipWithError(st.ok() ? "no test frame" : st.message().c_str());
-    return;
-  }
+  const std::unique_ptr<FaceTracker> t = MakeTracker(s, FaceTrackerOptions(), state);
+  if (!t) return;
   FaceInfo fi;
   for (auto _ : state) {
     t->reset();  // forces full-frame detection + landmarks
@@ -88,33 +98,15 @@ void BM_FaceDetectionMode(benchmark::State& state) {
 // Tracking with the default periodic re-detection (every 15 frames, near the
 // face): the amortized per-frame cost.
 void BM_FaceTrackingWithRedetection(benchmark::State& state) {
-  const Scene s = Make(state.range(0), state.range(1));
-  std::unique_ptr<FaceTracker> t;
-  const Status st = FaceTracker::Create(s.model, FaceTrackerOptions(), &t);
-  if (!st.ok() || s.frame.empty()) {
-    state.SkipWithError(st.ok() ? "no test frame" : st.message().c_str());
-    return;
-  }
-  FaceInfo fi;
-  double time = 1.0;
-  t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
-  for (auto _ : state) {
-    time += 1.0 / 30;
-    t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
-  }
-  state.counters["valid"] = fi.valid;
+  TrackAt30Fps(state, FaceTrackerOptions());
 }
 
 // The robot's view: a 30 px face, tracked with the default re-detection
 // (upsampled near the face) and landmarks on an upsampled crop.
 void BM_SmallFaceTracking(benchmark::State& state) {
   const Scene s = Make(640, 480, M_PI / 3.0, 2.75);
-  std::unique_ptr<FaceTracker> t;
-  const Status st = FaceTracker::Create(s.model, FaceTrackerOptions(), &t);
-  if (!st.ok() || s.frame.empty()) {
-    state.SkipWithError(st.ok() ? "no test frame" : st.message().c_str());
-    return;
-  }
+  const std::unique_ptr<FaceTracker> t = MakeTracker(s, FaceTrackerOptions(), state);
+  if (!t) return;
   FaceInfo fi;
   double time = 1.0;
   for (int i = 0; i < 10 && !fi.valid; ++i, time += 1.0 / 30) {  // acquire
@@ -142,12 +134,8 @@ void BM_SearchWithNobodyInView(benchmark::State& state) {
   const Scene s = Make(state.range(0), state.range(1), M_PI / 3.0, -1.0);
   FaceTrackerOptions o;
   if (state.range(2) > 0) o.detector.min_face_px = static_cast<int>(state.range(2));
-  std::unique_ptr<FaceTracker> t;
-  const Status st = FaceTracker::Create(s.model, o, &t);
-  if (!st.ok() || s.frame.empty()) {
-    state.SkipWithError(st.ok() ? "no test frame" : st.message().c_str());
-    return;
-  }
+  const std::unique_ptr<FaceTracker> t = MakeTracker(s, o, state);
+  if (!t) return;
   FaceInfo fi;
   double time = 1.0, worst = 0.0;
   for (auto _ : state) {

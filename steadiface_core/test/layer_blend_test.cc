@@ -87,22 +87,13 @@ TEST(LayerBlendTest, TheDefaultBandNeverBendsTheBackground) {
     LayerBlendReport rep;
     blend.Blend(Shifted(background, T), background, region, 0.0, 840, 460, &out, &rep);
     ASSERT_TRUE(rep.layered);
-    const int cols = static_cast<int>(g.u.size());
-    int outside_cells = 0;
-    for (int j = 0; j + 1 < static_cast<int>(g.v.size()); ++j) {
-      for (int i = 0; i + 1 < cols; ++i) {
-        const int c[4] = {j * cols + i, j * cols + i + 1, (j + 1) * cols + i,
-                          (j + 1) * cols + i + 1};
-        bool reaches_out = false;
-        for (int k : c) reaches_out = reaches_out || region.SignedDistance(g.At(k)) > 0.0;
-        if (!reaches_out) continue;
-        ++outside_cells;
-        for (int k : c) {
-          EXPECT_EQ(out[k], background[k]) << "vertex " << k << " of a cell reaching the background";
-        }
+    const auto outside = CellsReachingOut(g, region);
+    for (const auto& c : outside) {
+      for (int k : c) {
+        EXPECT_EQ(out[k], background[k]) << "vertex " << k << " of a cell reaching the background";
       }
     }
-    EXPECT_GT(outside_cells, 400);
+    EXPECT_GT(outside.size(), 400u);
     // The core: deeper inside than the band and the margin (a cell
     // diagonal, 28.2 px here). On this small head (jaw 100 px on a 20 px
     // grid) that leaves a core of ~7 px: 5 vertices, in the shoulders.

@@ -2,6 +2,7 @@
 // Meshes and subject regions with known geometry, for the layered warp's
 // tests (layer_blend_test.cc, subject_region_test.cc).
 
+#include <array>
 #include <vector>
 
 #include <Eigen/Core>
@@ -119,21 +120,32 @@ inline Eigen::Vector2d OffsetAt(const Grid& g, const std::vector<Eigen::Vector2f
          a * b * d(i + 1, j + 1);
 }
 
-// True when every cell that reaches outside the region's outline keeps all
-// four vertices exactly on the background layer.
-inline bool BackgroundUnbent(const Grid& g, const SubjectRegion& region,
-                      const std::vector<Eigen::Vector2f>& out,
-                      const std::vector<Eigen::Vector2f>& background) {
+// The mesh cells (their four vertex indices) that reach outside the
+// region's outline.
+inline std::vector<std::array<int, 4>> CellsReachingOut(const Grid& g,
+                                                       const SubjectRegion& region) {
+  std::vector<std::array<int, 4>> cells;
   const int cols = static_cast<int>(g.u.size());
   for (int j = 0; j + 1 < static_cast<int>(g.v.size()); ++j) {
     for (int i = 0; i + 1 < cols; ++i) {
-      const int c[4] = {j * cols + i, j * cols + i + 1, (j + 1) * cols + i,
-                        (j + 1) * cols + i + 1};
+      const std::array<int, 4> c = {j * cols + i, j * cols + i + 1, (j + 1) * cols + i,
+                                    (j + 1) * cols + i + 1};
       bool reaches_out = false;
       for (int k : c) reaches_out = reaches_out || region.SignedDistance(g.At(k)) > 0.0;
-      for (int k : c) {
-        if (reaches_out && out[k] != background[k]) return false;
-      }
+      if (reaches_out) cells.push_back(c);
+    }
+  }
+  return cells;
+}
+
+// True when every cell that reaches outside the region's outline keeps all
+// four vertices exactly on the background layer.
+inline bool BackgroundUnbent(const Grid& g, const SubjectRegion& region,
+                             const std::vector<Eigen::Vector2f>& out,
+                             const std::vector<Eigen::Vector2f>& background) {
+  for (const auto& c : CellsReachingOut(g, region)) {
+    for (int k : c) {
+      if (out[k] != background[k]) return false;
     }
   }
   return true;

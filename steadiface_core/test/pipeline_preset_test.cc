@@ -23,6 +23,18 @@ namespace {
 
 using testing_util::MakeSimulator;
 
+// The method with its default options on `s`, scored; `frames` gets the
+// stabilizer's record.
+eval::Score ScoreMethod(const sim::Simulator& s, eval::Method method,
+                        std::vector<StabilizerFrame>* frames) {
+  const PipelineOptions po = eval::OptionsFor(s, method);
+  std::unique_ptr<eval::Scorecard> card;
+  Status st = eval::MakeScorecard(s, po, &card);
+  if (st.ok()) st = eval::RunMethod(s, method, po, false, card.get(), frames);
+  EXPECT_TRUE(st.ok()) << st.message();
+  return st.ok() ? card->Compute() : eval::Score();
+}
+
 struct PresetResult {
   eval::Score none, gyro, full;
 };
@@ -169,12 +181,8 @@ TEST(PipelinePresetTest, BrightnessChangeKeepsTheFace) {
   EXPECT_GT(changed, 10);
   eval::Score full, gyro;
   for (eval::Method method : {eval::Method::kGyroOnly, eval::Method::kSteadiface}) {
-    const PipelineOptions po = eval::OptionsFor(*s, method);
-    std::unique_ptr<eval::Scorecard> card;
-    ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
     std::vector<StabilizerFrame> frames;
-    ASSERT_TRUE(eval::RunMethod(*s, method, po, false, card.get(), &frames).ok());
-    (method == eval::Method::kSteadiface ? full : gyro) = card->Compute();
+    (method == eval::Method::kSteadiface ? full : gyro) = ScoreMethod(*s, method, &frames);
     if (method == eval::Method::kSteadiface) {
       int used_after = 0, after = 0;
       for (size_t i = 0; i < frames.size(); ++i) {
@@ -201,12 +209,8 @@ TEST(PipelinePresetTest, ARobotsDistantFaceIsFoundAndTakenOverWithoutAStep) {
   EXPECT_NEAR(s->Truth(0).face_scale_px, 30.0, 1.0);
   eval::Score full, gyro;
   for (eval::Method method : {eval::Method::kGyroOnly, eval::Method::kSteadiface}) {
-    const PipelineOptions po = eval::OptionsFor(*s, method);
-    std::unique_ptr<eval::Scorecard> card;
-    ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
     std::vector<StabilizerFrame> frames;
-    ASSERT_TRUE(eval::RunMethod(*s, method, po, false, card.get(), &frames).ok());
-    (method == eval::Method::kSteadiface ? full : gyro) = card->Compute();
+    (method == eval::Method::kSteadiface ? full : gyro) = ScoreMethod(*s, method, &frames);
     if (method == eval::Method::kSteadiface) {
       int used = 0;
       for (const StabilizerFrame& f : frames) used += f.flags.face_used ? 1 : 0;

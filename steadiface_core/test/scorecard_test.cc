@@ -21,11 +21,16 @@ namespace {
 
 using testing_util::MakeSimulator;
 
-TEST(ScorecardTest, IdentityOnAStillSceneScoresZeroJitter) {
-  auto s = MakeSimulator("still", [](sim::SimulatorOptions* o) {
+// The still preset with a head that does not move either.
+std::unique_ptr<sim::Simulator> StillHead() {
+  return MakeSimulator("still", [](sim::SimulatorOptions* o) {
     o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
     o->head.yaw_amplitude_rad = o->head.pitch_amplitude_rad = o->head.lean_amplitude_m = 0.0;
   });
+}
+
+TEST(ScorecardTest, IdentityOnAStillSceneScoresZeroJitter) {
+  auto s = StillHead();
   std::unique_ptr<eval::Scorecard> scorecard;
   ASSERT_TRUE(eval::MakeScorecard(*s, PipelineOptions(), &scorecard).ok());
   eval::Scorecard& card = *scorecard;
@@ -61,10 +66,7 @@ TEST(ScorecardTest, AWarpThatCancelsTheTrueMotionScoresNearZero) {
 }
 
 TEST(ScorecardTest, AddedJitterRaisesTheScoreByTheExpectedAmount) {
-  auto s = MakeSimulator("still", [](sim::SimulatorOptions* o) {
-    o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
-    o->head.yaw_amplitude_rad = o->head.pitch_amplitude_rad = o->head.lean_amplitude_m = 0.0;
-  });
+  auto s = StillHead();
   std::unique_ptr<eval::Scorecard> scorecard;
   ASSERT_TRUE(eval::MakeScorecard(*s, PipelineOptions(), &scorecard).ok());
   eval::Scorecard& card = *scorecard;

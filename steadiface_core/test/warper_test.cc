@@ -48,6 +48,18 @@ OrientationTimeline ShakeTimeline(double amp = 3.0) {
   return tl;
 }
 
+// The background as the rolling-shutter camera sees it: each row at its
+// own time on the timeline.
+void RenderRows(const sim::InfiniteBackground& bg, const CameraIntrinsics& k,
+                const OrientationTimeline& tl, const RowTiming& timing, Time stamp,
+                cv::Mat* real) {
+  bg.Render(k, [&](double y) {
+    Eigen::Quaterniond R;
+    tl.RealRotation(timing.RowTime(stamp, y), &R);
+    return R;
+  }, 1, real);
+}
+
 TEST(WarperTest, IdentityPoseGivesTheScaledCentreCrop) {
   cv::Mat photo;
   cv::resize(LoadImage("coffee.png"), photo, cv::Size(640, 480), 0, 0,
@@ -135,11 +147,7 @@ TEST(WarperTest, PureRotationLandsBackgroundOnGroundTruthView) {
   // Real frame, rendered row by row with the true timeline.
   const sim::InfiniteBackground bg(photo, 500.0);
   cv::Mat real;
-  bg.Render(k, [&](double y) {
-    Eigen::Quaterniond R;
-    tl.RealRotation(timing.RowTime(stamp, y), &R);
-    return R;
-  }, 1, &real);
+  RenderRows(bg, k, tl, timing, stamp, &real);
   WarpOptions o;
   o.output.crop_ratio = 0.1;
   o.fixed_point_maps = false;
@@ -242,11 +250,7 @@ TEST(WarperTest, RollingShutterStraightensVerticalLines) {
   const RowTiming timing(rs, k.height);
   const Time stamp = At(0.51);
   cv::Mat real;
-  bg.Render(k, [&](double y) {
-    Eigen::Quaterniond R;
-    tl.RealRotation(timing.RowTime(stamp, y), &R);
-    return R;
-  }, 1, &real);
+  RenderRows(bg, k, tl, timing, stamp, &real);
   RowRotations rows;
   ASSERT_EQ(RowRotations::Build(tl, timing, stamp, 64, &rows), QueryResult::kOk);
   WarpOptions o;

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include <ros/package.h>
 #include <yaml-cpp/yaml.h>
 
 #include "steadiface_ros/resource_url.h"
@@ -292,6 +293,18 @@ Status LoadOptions(const ParamSource& params, steadiface::PipelineOptions* po,
   if (!st.ok()) return st;
   // Cross-field checks of the core (e.g. low < high) with its own messages.
   return steadiface::ValidatePipelineOptions(*po);
+}
+
+Status LoadPackageOptions(const std::vector<std::string>& overlays,
+                          steadiface::PipelineOptions* po, WrapperOptions* wo) {
+  std::vector<std::string> files;
+  const std::string pkg = ros::package::getPath("steadiface");
+  if (!pkg.empty()) files.push_back(pkg + "/config/default.yaml");
+  files.insert(files.end(), overlays.begin(), overlays.end());
+  std::unique_ptr<ParamSource> params;
+  Status st = YamlParams(files, &params);
+  if (st.ok()) st = LoadOptions(*params, po, wo);
+  return st;
 }
 
 }  // namespace steadiface_ros

@@ -82,18 +82,23 @@ std::string ReadFile(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
 }
 
+// LoadOptions over config/default.yaml and an overlay with `yaml` (written
+// to a temporary file and removed).
+steadiface::Status LoadWithOverlay(const std::string& yaml, steadiface::PipelineOptions* po,
+                                   WrapperOptions* wo) {
+  const std::string path = ::testing::TempDir() + "steadiface_params_overlay.yaml";
+  std::ofstream(path) << yaml;
+  std::unique_ptr<ParamSource> source;
+  steadiface::Status s = YamlParams({kDefaultYaml, path}, &source);
+  if (s.ok()) s = LoadOptions(*source, po, wo);
+  std::remove(path.c_str());
+  return s;
+}
+
 TEST(ParamsTest, FileParametersResolvePackageUrls) {
-  const std::string cascade = ::testing::TempDir() + "steadiface_params_cascade.yaml";
-  {
-    std::ofstream f(cascade);
-    f << "face:\n  detector: opencv_cascade\n";
-  }
-  std::unique_ptr<ParamSource> yaml;
-  ASSERT_TRUE(YamlParams({kDefaultYaml, cascade}, &yaml).ok());
   steadiface::PipelineOptions po;
   WrapperOptions wo;
-  ASSERT_TRUE(LoadOptions(*yaml, &po, &wo).ok());
-  std::remove(cascade.c_str());
+  ASSERT_TRUE(LoadWithOverlay("face:\n  detector: opencv_cascade\n", &po, &wo).ok());
   // package:// needs ROS_PACKAGE_PATH; the catkin test environment has it.
   const std::string& path = po.face.detector.cascade_path;
   EXPECT_EQ(path.find("://"), std::string::npos) << path;
@@ -104,30 +109,19 @@ TEST(ParamsTest, FileParametersResolvePackageUrls) {
   const std::string system = ReadFile(steadiface::FaceDetectorOptions().cascade_path);
   if (!system.empty()) EXPECT_TRUE(shipped == system);
 
-  const std::string overlay = ::testing::TempDir() + "steadiface_params_url.yaml";
-  {
-    std::ofstream f(overlay);
-    f << "face:\n  landmark_model: package://no_such_package_xyz/model.dat\n";
-  }
-  ASSERT_TRUE(YamlParams({kDefaultYaml, overlay}, &yaml).ok());
-  const steadiface::Status s = LoadOptions(*yaml, &po, &wo);
+  const steadiface::Status s = LoadWithOverlay(
+      "face:\n  landmark_model: package://no_such_package_xyz/model.dat\n", &po, &wo);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("face/landmark_model"), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("no_such_package_xyz"), std::string::npos) << s.message();
-  std::remove(overlay.c_str());
 
   // The dlib detector does not use the cascade: an unresolvable cascade URL
   // is kept as it is, not an error (a run outside a sourced workspace).
-  {
-    std::ofstream f(overlay);
-    f << "face:\n  cascade_path: package://no_such_package_xyz/c.xml\n";
-  }
-  ASSERT_TRUE(YamlParams({kDefaultYaml, overlay}, &yaml).ok());
   steadiface::PipelineOptions dlib;
-  const steadiface::Status ok = LoadOptions(*yaml, &dlib, &wo);
+  const steadiface::Status ok =
+      LoadWithOverlay("face:\n  cascade_path: package://no_such_package_xyz/c.xml\n", &dlib, &wo);
   EXPECT_TRUE(ok.ok()) << ok.message();
   EXPECT_EQ(dlib.face.detector.cascade_path, "package://no_such_package_xyz/c.xml");
-  std::remove(overlay.c_str());
 }
 
 TEST(ParamsTest, ReconfigureDefaultsAreTheCoreDefaults) {
@@ -282,22 +276,16 @@ TEST(ParamsTest, EveryReconfigureParameterReachesTheOptionsAndBack) {
 }
 
 TEST(ParamsTest, AChoiceOutsideTheTablesNamesTheChoices) {
-  const std::string path = ::testing::TempDir() + "steadiface_params_choice.yaml";
-  std::ofstream(path) << "late_frame_policy: wait\n";
-  std::unique_ptr<ParamSource> yaml;
-  ASSERT_TRUE(YamlParams({kDefaultYaml, path}, &yaml).ok());
   steadiface::PipelineOptions po;
   WrapperOptions wo;
-  const steadiface::Status s = LoadOptions(*yaml, &po, &wo);
+  const steadiface::Status s = LoadWithOverlay("late_frame_policy: wait\n", &po, &wo);
   EXPECT_FALSE(s.ok());
   EXPECT_EQ(s.message(),
             "parameter 'late_frame_policy' must be one of extrapolate | drop, got 'wait'");
-  std::ofstream(path) << "late_frame_policy: drop\ncamera:\n  stamp: middle_row\n";
-  ASSERT_TRUE(YamlParams({kDefaultYaml, path}, &yaml).ok());
-  ASSERT_TRUE(LoadOptions(*yaml, &po, &wo).ok());
+  ASSERT_TRUE(
+      LoadWithOverlay("late_frame_policy: drop\ncamera:\n  stamp: middle_row\n", &po, &wo).ok());
   EXPECT_EQ(wo.scheduler.late_frame_policy, steadiface::LateFramePolicy::kDrop);
   EXPECT_EQ(po.shutter.stamp, steadiface::StampConvention::kMiddleRow);
-  std::remove(path.c_str());
 }
 
 // The core's validation accepts every value the table's ranges allow: each
@@ -355,19 +343,11 @@ TEST(ParamsTest, TheCoreAcceptsEveryValueInTheTablesRanges) {
 }
 
 TEST(ParamsTest, AnOutOfRangeValueNamesItsKey) {
-  const std::string path = ::testing::TempDir() + "steadiface_params_test.yaml";
-  {
-    std::ofstream f(path);
-    f << "output:\n  crop_ratio: 0.7\n";
-  }
-  std::unique_ptr<ParamSource> yaml;
-  ASSERT_TRUE(YamlParams({kDefaultYaml, path}, &yaml).ok());
   steadiface::PipelineOptions po;
   WrapperOptions wo;
-  const steadiface::Status s = LoadOptions(*yaml, &po, &wo);
+  const steadiface::Status s = LoadWithOverlay("output:\n  crop_ratio: 0.7\n", &po, &wo);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("output/crop_ratio"), std::string::npos) << s.message();
-  std::remove(path.c_str());
 }
 
 }  // namespace

@@ -435,18 +435,18 @@ TEST(WrapperTest, BackgroundLayerIsPublishedAsItsOwnFrameWhenOn) {
   ExpectAllFinite(on_sink);
 }
 
+// A sink that also keeps the debug images.
+struct DebugSink : public Sink {
+  std::vector<sensor_msgs::ImagePtr> debug;
+  bool WantsDebugImage() const override { return true; }
+  void PublishDebugImage(const sensor_msgs::ImagePtr& i) override { debug.push_back(i); }
+};
+
 // warp/mode layered: both virtual cameras in TF, the mode and the blend's
 // figures in `state`, a full-size output, the debug image with the region
 // drawn, and camera_info for the background layer (most of the frame). A
 // reconfigure back to global takes effect from the next frame.
 TEST(WrapperTest, LayeredModePublishesBothLayersAndSwitchesBackToGlobal) {
-  struct DebugSink : public Sink {
-    std::vector<sensor_msgs::ImagePtr> debug;
-    bool WantsDebugImage() const override { return true; }
-    void PublishDebugImage(const sensor_msgs::ImagePtr& i) override {
-      debug.push_back(i);
-    }
-  };
   DebugSink sink;
   steadiface::PipelineOptions po = Options();
   po.landmark_source =
@@ -500,13 +500,6 @@ TEST(WrapperTest, LayeredModePublishesBothLayersAndSwitchesBackToGlobal) {
 // the background layer, the debug image with the matte; the face's pixels
 // where the subject layer holds them.
 TEST(WrapperTest, CompositeModeSwitchedOnAtRunTimePublishesItsState) {
-  struct DebugSink : public Sink {
-    std::vector<sensor_msgs::ImagePtr> debug;
-    bool WantsDebugImage() const override { return true; }
-    void PublishDebugImage(const sensor_msgs::ImagePtr& i) override {
-      debug.push_back(i);
-    }
-  };
   DebugSink sink;
   steadiface::PipelineOptions po = Options();
   po.landmark_source =

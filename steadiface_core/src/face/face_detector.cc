@@ -56,6 +56,15 @@ Status CheckInput(const cv::Mat& gray, const cv::Rect& roi) {
   return Status::Ok();
 }
 
+// A box (x, y, w, h) found in the region scaled by s, in the frame's pixels.
+FaceBox InFrame(const cv::Rect& roi, double s, double x, double y, double w, double h,
+                double score) {
+  FaceBox f;
+  f.rect = cv::Rect2d(roi.x + x / s, roi.y + y / s, w / s, h / s);
+  f.score = score;
+  return f;
+}
+
 // dlib's frontal face detector ships compressed inside the library and
 // takes ~0.35 s to decode; its dlib serialization reads in ~2 ms. The
 // serialized copy is kept in the model cache (DefaultModelCacheDir()),
@@ -100,78 +109,83 @@ dlib::frontal_face_detector LoadFrontalFaceDetector(const std::string& cache_dir
   return d;
 }
 
-class DlibHogDetector : public FaceDetector {
+// What both detectors share: the region scaled (at most max_side_px long),
+// searched by DetectScaled, and the boxes sorted largest first.
+class ScaledDetector : public FaceDetector {
  public:
-  explicit DlibHogDetector(const FaceDetectorOptions& o)
-      : options_(o), detector_(LoadFrontalFaceDetector(DefaultModelCacheDir())) {}
+  explicit ScaledDetector(const FaceDetectorOptions& o) : options_(o) {}
 
-  Status Detect(const cv::Mat& gray, const cv::Rect& roi,
-                std::vector<FaceBox>* faces, double scale) override {
+  Status Detect(const cv::Mat& gray, const cv::Rect& roi, std::vector<FaceBox>* faces,
+                double scale) override {
     faces->clear();
-    Status st = CheckInput(gray, roi);
+    const Status st = CheckInput(gray, roi);
     if (!st.ok()) return st;
     cv::Mat small;
     const double s = ScaledCopy(gray, roi, scale, options_.max_side_px, &small);
-    if (small.cols < 40 || small.rows < 40) return Status::Ok();
+    DetectScaled(small, roi, s, faces);
+    SortLargestFirst(faces);
+    return Status::Ok();
+  }
+
+ protected:
+  // The faces in `small`, the region `roi` scaled by s, in the frame's pixels.
+  virtual void DetectScaled(cv::Mat small, const cv::Rect& roi, double s,
+                            std::vector<FaceBox>* faces) = 0;
+
+  const FaceDetectorOptions options_;
+};
+
+class DlibHogDetector : public ScaledDetector {
+ public:
+  explicit DlibHogDetector(const FaceDetectorOptions& o)
+      : ScaledDetector(o), detector_(LoadFrontalFaceDetector(DefaultModelCacheDir())) {}
+
+  // dlib's HOG window is 80 px square; its boxes come out from ~70 px.
+  double window_px() const override { return 75.0; }
+
+ private:
+  void DetectScaled(cv::Mat small, const cv::Rect& roi, double s,
+                    std::vector<FaceBox>* faces) override {
+    if (small.cols < 40 || small.rows < 40) return;
     if (!small.isContinuous()) small = small.clone();
     dlib::cv_image<unsigned char> img(small);
     std::vector<dlib::rect_detection> dets;
     detector_(img, dets, options_.dlib_threshold);
     for (const auto& d : dets) {
       const dlib::rectangle& r = d.rect;
-      FaceBox f;
-      f.rect = cv::Rect2d(roi.x + r.left() / s, roi.y + r.top() / s,
-                          r.width() / s, r.height() / s);
-      f.score = d.detection_confidence;
+      const FaceBox f =
+          InFrame(roi, s, r.left(), r.top(), r.width(), r.height(), d.detection_confidence);
       // A box is a rough measure of the face (+-10 %): keep those that may
       // be min_face_px wide.
       if (f.rect.width >= kBoxTolerance * options_.min_face_px) faces->push_back(f);
     }
-    SortLargestFirst(faces);
-    return Status::Ok();
   }
 
-  // dlib's HOG window is 80 px square; its boxes come out from ~70 px.
-  double window_px() const override { return 75.0; }
-
- private:
-  const FaceDetectorOptions options_;
   dlib::frontal_face_detector detector_;
 };
 
-class CascadeDetector : public FaceDetector {
+class CascadeDetector : public ScaledDetector {
  public:
-  CascadeDetector(const FaceDetectorOptions& o) : options_(o) {}
+  explicit CascadeDetector(const FaceDetectorOptions& o) : ScaledDetector(o) {}
   bool Load() { return cascade_.load(options_.cascade_path); }
-
-  Status Detect(const cv::Mat& gray, const cv::Rect& roi,
-                std::vector<FaceBox>* faces, double scale) override {
-    faces->clear();
-    Status st = CheckInput(gray, roi);
-    if (!st.ok()) return st;
-    cv::Mat small;
-    const double s = ScaledCopy(gray, roi, scale, options_.max_side_px, &small);
-    std::vector<cv::Rect> rects;
-    std::vector<int> neighbours;
-    const int min_px = std::max(20, static_cast<int>(options_.min_face_px * s));
-    cascade_.detectMultiScale(small, rects, neighbours, 1.1, 4, 0,
-                              cv::Size(min_px, min_px));
-    for (size_t i = 0; i < rects.size(); ++i) {
-      FaceBox f;
-      f.rect = cv::Rect2d(roi.x + rects[i].x / s, roi.y + rects[i].y / s,
-                          rects[i].width / s, rects[i].height / s);
-      f.score = i < neighbours.size() ? neighbours[i] : 0;
-      faces->push_back(f);
-    }
-    SortLargestFirst(faces);
-    return Status::Ok();
-  }
 
   // The frontal cascades' windows are 20-24 px.
   double window_px() const override { return 24.0; }
 
  private:
-  const FaceDetectorOptions options_;
+  void DetectScaled(cv::Mat small, const cv::Rect& roi, double s,
+                    std::vector<FaceBox>* faces) override {
+    std::vector<cv::Rect> rects;
+    std::vector<int> neighbours;
+    const int min_px = std::max(20, static_cast<int>(options_.min_face_px * s));
+    cascade_.detectMultiScale(small, rects, neighbours, 1.1, 4, 0, cv::Size(min_px, min_px));
+    for (size_t i = 0; i < rects.size(); ++i) {
+      const cv::Rect& r = rects[i];
+      faces->push_back(InFrame(roi, s, r.x, r.y, r.width, r.height,
+                               i < neighbours.size() ? neighbours[i] : 0));
+    }
+  }
+
   cv::CascadeClassifier cascade_;
 };
 

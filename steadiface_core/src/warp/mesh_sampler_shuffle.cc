@@ -126,10 +126,84 @@ bool ShuffleSupported() { return true; }
 
 namespace {
 
-// The 3-channel kernel's constants and tables, loaded once per segment.
-struct Color3Consts {
+// A segment's start and steps in locals (the output stores may alias seg,
+// so the compiler would reload its fields after each one), the lanes'
+// offsets for 4-pixel coordinate vectors and their step per 4 pixels.
+struct SegmentLanes {
+  int32_t X0, Y0, DX, DY;
+  int u0;
+  cv::v_int32x4 ramp, rampy, dx4, dy4;
+};
+
+STEADIFACE_SHUFFLE_TARGET inline SegmentLanes Lanes(const ScanSegment& seg) {
+  using namespace cv;
+  const int32_t DX = seg.DX, DY = seg.DY;
+  return {seg.X,
+          seg.Y,
+          DX,
+          DY,
+          seg.u0,
+          v_int32x4(0, DX, 2 * DX, 3 * DX),
+          v_int32x4(0, DY, 2 * DY, 3 * DY),
+          v_setall_s32(4 * DX),
+          v_setall_s32(4 * DY)};
+}
+
+// Moves the coordinates to pixel g of the segment (for the overlapping last
+// group, as in SampleRow, and the start).
+STEADIFACE_SHUFFLE_TARGET inline void MoveTo(const SegmentLanes& L, int g, int32_t* X, int32_t* Y,
+                                             cv::v_int32x4* Xv, cv::v_int32x4* Yv) {
+  *X = L.X0 + g * L.DX;
+  *Y = L.Y0 + g * L.DY;
+  *Xv = cv::v_setall_s32(*X) + L.ramp;
+  *Yv = cv::v_setall_s32(*Y) + L.rampy;
+}
+
+// A segment shorter than one group of `group` pixels: sampled pixel by
+// pixel. True when it was one.
+inline bool ShortSegment(const ScanSegment& seg, const cv::Mat& in, int cn, int group,
+                         uchar* out, SampleStats* counts) {
+  const int n = seg.u1 - seg.u0 + 1;
+  if (n >= group) return false;
+  SamplePixels(in, cn, seg.X, seg.Y, seg.DX, seg.DY, n, out + seg.u0 * cn);
+  counts->scalar_px += n;
+  return true;
+}
+
+// How many pixels each path sampled, added to the segment's counts.
+struct PathCounts {
+  int64_t shuffled = 0, portable = 0, scalar = 0;
+  void AddTo(SampleStats* counts) const {
+    counts->shuffle_px += shuffled;
+    counts->portable_simd_px += portable;
+    counts->scalar_px += scalar;
+  }
+};
+
+}  // namespace
+
+namespace {
+
+// Both kernels' interpolation constants: the fraction mask (31) and 32,
+// each also times 64 (fy, 64 times, comes from Y in one shift:
+// Y >> (kScanFrac - 6), masked), 255 and the rounding half.
+struct InterConsts {
   cv::v_int32x4 m31, m31x64, k32, k32x64, half;
   cv::v_uint16x8 k255;
+};
+
+STEADIFACE_SHUFFLE_TARGET inline void LoadInterConsts(InterConsts* k) {
+  using namespace cv;
+  k->m31 = v_setall_s32(kInterTabSize - 1);
+  k->m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
+  k->k32 = v_setall_s32(kInterTabSize);
+  k->k32x64 = v_setall_s32(kInterTabSize << 6);
+  k->k255 = v_setall_u16(255);
+  k->half = v_setall_s32(1 << 15);
+}
+
+// The 3-channel kernel's constants and tables, loaded once per segment.
+struct Color3Consts : InterConsts {
   cv::v_uint8x16 pix_a, pix_b, off_a, off_b, wsel_a, wsel_b, word0, word1, word2, out0, out1,
       out2;
 };
@@ -137,13 +211,7 @@ struct Color3Consts {
 STEADIFACE_SHUFFLE_TARGET inline Color3Consts LoadColor3Consts() {
   using namespace cv;
   Color3Consts k;
-  k.m31 = v_setall_s32(kInterTabSize - 1);
-  // fy, 64 times, from Y in one shift: Y >> (kScanFrac - 6), masked.
-  k.m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
-  k.k32 = v_setall_s32(kInterTabSize);
-  k.k32x64 = v_setall_s32(kInterTabSize << 6);
-  k.k255 = v_setall_u16(255);
-  k.half = v_setall_s32(1 << 15);
+  LoadInterConsts(&k);
   k.pix_a = v_load(kColor3Shuffle.pair_pixel_byte[0]);
   k.pix_b = v_load(kColor3Shuffle.pair_pixel_byte[1]);
   k.off_a = v_load(kColor3Shuffle.pair_offset[0]);
@@ -216,16 +284,10 @@ STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
   constexpr int shift = kScanFrac + kInterBits;
   const uchar* base = in.ptr<uchar>(0);
   const size_t step = in.step[0];
+  if (ShortSegment(seg, in, 3, 4, out, counts)) return;
   const int n = seg.u1 - seg.u0 + 1;
-  if (n < 4) {
-    SamplePixels(in, 3, seg.X, seg.Y, seg.DX, seg.DY, n, out + seg.u0 * 3);
-    counts->scalar_px += n;
-    return;
-  }
-  // Locals, not seg's fields: the output stores (uchar) may alias seg, so
-  // the compiler would reload them after each one.
-  const int32_t X0 = seg.X, Y0 = seg.Y, DX = seg.DX, DY = seg.DY;
-  const int u0 = seg.u0;
+  const SegmentLanes L = Lanes(seg);
+  const int32_t X0 = L.X0, Y0 = L.Y0, DX = L.DX, DY = L.DY;
   const int max_iy = in.rows - 2;
   // A 16-byte load at pixel ix0 stays in its row for ix0 <= cols - 6.
   const int max_ix_shuffle = in.cols - 6;
@@ -235,24 +297,14 @@ STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
   // within a group, and only that is checked per group.
   const bool whole = DX >= 0 && DX <= (1 << shift) &&
                      GroupInside(X0, Y0, DX, DY, n, max_ix_shuffle, max_iy);
-  const v_int32x4 ramp(0, DX, 2 * DX, 3 * DX);
-  const v_int32x4 rampy(0, DY, 2 * DY, 3 * DY);
-  const v_int32x4 dx4 = v_setall_s32(4 * DX), dy4 = v_setall_s32(4 * DY);
   const Color3Consts k = LoadColor3Consts();
-  int64_t shuffled = 0, portable = 0, scalar = 0;
-  int32_t X = X0, Y = Y0;
-  // The group's 4 coordinates, stepped like X and Y.
-  v_int32x4 Xv = v_setall_s32(X0) + ramp, Yv = v_setall_s32(Y0) + rampy;
-  for (int g = 0; g < n;
-       g += 4, X += 4 * DX, Y += 4 * DY, Xv += dx4, Yv += dy4) {
-    if (g + 4 > n) {  // overlapping last group, as in SampleRow
-      g = n - 4;
-      X = X0 + g * DX;
-      Y = Y0 + g * DY;
-      Xv = v_setall_s32(X) + ramp;
-      Yv = v_setall_s32(Y) + rampy;
-    }
-    const int u = u0 + g;
+  PathCounts c;
+  int32_t X, Y;
+  v_int32x4 Xv, Yv;  // the group's 4 coordinates, stepped like X and Y
+  MoveTo(L, 0, &X, &Y, &Xv, &Yv);
+  for (int g = 0; g < n; g += 4, X += 4 * DX, Y += 4 * DY, Xv += L.dx4, Yv += L.dy4) {
+    if (g + 4 > n) MoveTo(L, g = n - 4, &X, &Y, &Xv, &Yv);
+    const int u = L.u0 + g;
     const int ix0 = X >> shift, iy0 = Y >> shift;
     const int iy3 = (Y + 3 * DY) >> shift;
     uchar* dst = out + u * 3;
@@ -262,10 +314,10 @@ STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
           ix0 < 0 || ix0 > max_ix_shuffle || iy0 < 0 || iy0 > max_iy))) {
       if (GroupInside(X, Y, DX, DY, 4, max_ix_portable, max_iy)) {
         Color4<3>(base, step, Xv, Yv, u + 6 <= width, dst);
-        portable += 4;
+        c.portable += 4;
       } else {
         SamplePixels(in, 3, X, Y, DX, DY, 4, dst);
-        scalar += 4;
+        c.scalar += 4;
       }
       continue;
     }
@@ -278,18 +330,14 @@ STEADIFACE_SHUFFLE_TARGET void Color3SegmentShuffle(const ScanSegment& seg,
       const unsigned tail = v_extract_n<2>(v_reinterpret_as_u32(r));
       std::memcpy(dst + 8, &tail, 4);
     }
-    shuffled += 4;
+    c.shuffled += 4;
   }
-  counts->shuffle_px += shuffled;
-  counts->portable_simd_px += portable;
-  counts->scalar_px += scalar;
+  c.AddTo(counts);
 }
 namespace {
 
 // The 1-channel kernel's constants and tables, loaded once per segment.
-struct Mono8Consts {
-  cv::v_int32x4 m31, m31x64, k32, k32x64, half;
-  cv::v_uint16x8 k255;
+struct Mono8Consts : InterConsts {
   cv::v_uint8x16 pair_low, left_right, out0, out1;
 };
 
@@ -309,12 +357,7 @@ STEADIFACE_SHUFFLE_TARGET inline Mono8Consts LoadMono8Consts() {
       0x80, 0x80, 0x80, 0x80, 2,    6,    10,   14,
       0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80};
   Mono8Consts k;
-  k.m31 = v_setall_s32(kInterTabSize - 1);
-  k.m31x64 = v_setall_s32((kInterTabSize - 1) << 6);
-  k.k32 = v_setall_s32(kInterTabSize);
-  k.k32x64 = v_setall_s32(kInterTabSize << 6);
-  k.k255 = v_setall_u16(255);
-  k.half = v_setall_s32(1 << 15);
+  LoadInterConsts(&k);
   k.pair_low = v_load(kPairLow);
   k.left_right = v_load(kLeftRight);
   k.out0 = v_load(kOut0);
@@ -375,15 +418,10 @@ STEADIFACE_SHUFFLE_TARGET void Mono8SegmentShuffle(const ScanSegment& seg,
   constexpr int shift = kScanFrac + kInterBits;
   const uchar* base = in.ptr<uchar>(0);
   const size_t step = in.step[0];
+  if (ShortSegment(seg, in, 1, 8, out, counts)) return;
   const int n = seg.u1 - seg.u0 + 1;
-  if (n < 8) {
-    SamplePixels(in, 1, seg.X, seg.Y, seg.DX, seg.DY, n, out + seg.u0);
-    counts->scalar_px += n;
-    return;
-  }
-  // Locals, not seg's fields (the output stores may alias seg).
-  const int32_t X0 = seg.X, Y0 = seg.Y, DX = seg.DX, DY = seg.DY;
-  const int u0 = seg.u0;
+  const SegmentLanes L = Lanes(seg);
+  const int32_t X0 = L.X0, Y0 = L.Y0, DX = L.DX, DY = L.DY;
   const int max_iy = in.rows - 2;
   // A 16-byte load at pixel ix0 stays in its row for ix0 <= cols - 16.
   const int max_ix_shuffle = in.cols - 16;
@@ -391,47 +429,36 @@ STEADIFACE_SHUFFLE_TARGET void Mono8SegmentShuffle(const ScanSegment& seg,
   // source row is checked per group.
   const bool whole = DX >= 0 && 7 * static_cast<int64_t>(DX) <= (14 << shift) &&
                      GroupInside(X0, Y0, DX, DY, n, max_ix_shuffle, max_iy);
-  const v_int32x4 ramp(0, DX, 2 * DX, 3 * DX);
-  const v_int32x4 rampy(0, DY, 2 * DY, 3 * DY);
-  const v_int32x4 dx4 = v_setall_s32(4 * DX), dy4 = v_setall_s32(4 * DY);
   const v_int32x4 dx8 = v_setall_s32(8 * DX), dy8 = v_setall_s32(8 * DY);
   const Mono8Consts k = LoadMono8Consts();
-  int64_t shuffled = 0, portable = 0, scalar = 0;
-  int32_t X = X0, Y = Y0;
-  v_int32x4 Xa = v_setall_s32(X0) + ramp, Ya = v_setall_s32(Y0) + rampy;
-  for (int g = 0; g < n;
-       g += 8, X += 8 * DX, Y += 8 * DY, Xa += dx8, Ya += dy8) {
-    if (g + 8 > n) {  // overlapping last group, as in SampleRow
-      g = n - 8;
-      X = X0 + g * DX;
-      Y = Y0 + g * DY;
-      Xa = v_setall_s32(X) + ramp;
-      Ya = v_setall_s32(Y) + rampy;
-    }
-    const int u = u0 + g;
+  PathCounts c;
+  int32_t X, Y;
+  v_int32x4 Xa, Ya;  // pixels 0-3 (a; 4-7: b) of the group, stepped like X and Y
+  MoveTo(L, 0, &X, &Y, &Xa, &Ya);
+  for (int g = 0; g < n; g += 8, X += 8 * DX, Y += 8 * DY, Xa += dx8, Ya += dy8) {
+    if (g + 8 > n) MoveTo(L, g = n - 8, &X, &Y, &Xa, &Ya);
+    const int u = L.u0 + g;
     const int ix0 = X >> shift, iy0 = Y >> shift;
     const int iy7 = (Y + 7 * DY) >> shift;
-    const v_int32x4 Xb = Xa + dx4, Yb = Ya + dy4;
+    const v_int32x4 Xb = Xa + L.dx4, Yb = Ya + L.dy4;
     if (iy0 != iy7 ||
         (!whole &&
          (static_cast<unsigned>(((X + 7 * DX) >> shift) - ix0) > 14u ||
           ix0 < 0 || ix0 > max_ix_shuffle || iy0 < 0 || iy0 > max_iy))) {
       if (GroupInside(X, Y, DX, DY, 8, in.cols - 2, max_iy)) {
         Mono8(base, step, Xa, Xb, Ya, Yb, out + u);
-        portable += 8;
+        c.portable += 8;
       } else {
         SamplePixels(in, 1, X, Y, DX, DY, 8, out + u);
-        scalar += 8;
+        c.scalar += 8;
       }
       continue;
     }
     const uchar* p = base + static_cast<size_t>(iy0) * step + ix0;
     v_store_low(out + u, Mono8Group(k, p, step, ix0, Xa, Xb, Ya, Yb));
-    shuffled += 8;
+    c.shuffled += 8;
   }
-  counts->shuffle_px += shuffled;
-  counts->portable_simd_px += portable;
-  counts->scalar_px += scalar;
+  c.AddTo(counts);
 }
 #endif  // STEADIFACE_SHUFFLE_KERNEL
 

@@ -92,6 +92,13 @@ steadiface::Status LoadOptions(const ParamSource& params,
                                steadiface::PipelineOptions* pipeline,
                                WrapperOptions* wrapper);
 
+/// The offline tools' start: config/default.yaml of the installed package
+/// (ros::package), then `overlays` in order (later ones win), through
+/// LoadOptions.
+steadiface::Status LoadPackageOptions(const std::vector<std::string>& overlays,
+                                      steadiface::PipelineOptions* pipeline,
+                                      WrapperOptions* wrapper);
+
 /// dynamic_reconfigure <-> the options it changes at run time (the
 /// stabilizer's weights and terms, the warp mode, the layered warp's band and
 /// region). Both are generated from config/parameters.yaml (each run-time

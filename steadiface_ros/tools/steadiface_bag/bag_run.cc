@@ -11,7 +11,6 @@
 #include <iostream>
 #include <memory>
 
-#include <ros/package.h>
 #include <rosbag/bag.h>
 
 #include "steadiface_bag/bag_report.h"
@@ -32,13 +31,7 @@ using steadiface::Status;
 // decides (pipelined rendering, gyro only, landmarks from a topic).
 Status LoadBagOptions(const BagRunOptions& a, steadiface::PipelineOptions* po,
                       steadiface_ros::WrapperOptions* wo) {
-  std::vector<std::string> param_files;
-  const std::string pkg = ros::package::getPath("steadiface");
-  if (!pkg.empty()) param_files.push_back(pkg + "/config/default.yaml");
-  param_files.insert(param_files.end(), a.params.begin(), a.params.end());
-  std::unique_ptr<steadiface_ros::ParamSource> params;
-  Status st = steadiface_ros::YamlParams(param_files, &params);
-  if (st.ok()) st = steadiface_ros::LoadOptions(*params, po, wo);
+  const Status st = steadiface_ros::LoadPackageOptions(a.params, po, wo);
   if (!st.ok()) return st;
   // Offline, throughput counts and latency does not: render each frame on
   // a second thread while the next one is processed (same output).

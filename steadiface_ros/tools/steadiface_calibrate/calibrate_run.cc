@@ -9,7 +9,6 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <ros/package.h>
 
 #include "steadiface_bag/bounded_queue.h"
 #include "steadiface_core/calibration/calibrator.h"
@@ -62,19 +61,6 @@ void Plot(const steadiface::CalibrationResult& r, const std::string& path) {
   cv::imwrite(path, img);
 }
 
-
-// The starting point: the package defaults and the user's overlays.
-Status LoadStart(const CalibrateOptions& o, steadiface::PipelineOptions* po,
-                 steadiface_ros::WrapperOptions* wo) {
-  std::vector<std::string> files;
-  const std::string pkg = ros::package::getPath("steadiface");
-  if (!pkg.empty()) files.push_back(pkg + "/config/default.yaml");
-  files.insert(files.end(), o.params.begin(), o.params.end());
-  std::unique_ptr<steadiface_ros::ParamSource> params;
-  Status st = steadiface_ros::YamlParams(files, &params);
-  if (st.ok()) st = steadiface_ros::LoadOptions(*params, po, wo);
-  return st;
-}
 
 // Feeds a bag's gyro samples and images to a Calibrator, made at the first
 // image (it needs the intrinsics).
@@ -255,7 +241,8 @@ Status Calibrate(const CalibrateOptions& o, steadiface::CalibrationResult* r, si
                  size_t* imu) {
   steadiface::PipelineOptions po;
   steadiface_ros::WrapperOptions wo;
-  Status st = LoadStart(o, &po, &wo);
+  // The starting point: the package defaults and the user's overlays.
+  Status st = steadiface_ros::LoadPackageOptions(o.params, &po, &wo);
   if (!st.ok()) return st;
   const bool quiet = o.quiet;
   steadiface_ros::CameraInfoSource info_source([quiet](bool is_error, const std::string& text) {
