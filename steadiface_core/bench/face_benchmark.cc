@@ -26,7 +26,10 @@ struct Scene {
 // `distance_m` < 0: no face.
 Scene Make(int w, int h, double hfov = 1.0, double distance_m = 0.45) {
   Scene s;
-  CameraModel::Create(IntrinsicsFromHorizontalFov(w, h, hfov), CameraModelOptions(), &s.model);
+  if (!CameraModel::Create(IntrinsicsFromHorizontalFov(w, h, hfov), CameraModelOptions(), &s.model)
+           .ok()) {
+    return s;  // no frame: the benchmark skips
+  }
   const std::string data = STEADIFACE_TEST_DATA_DIR;
   const cv::Mat photo = cv::imread(data + "/astronaut.png");
   const sim::InfiniteBackground bg(cv::imread(data + "/building.jpg"), 600.0 * w / 640.0);
@@ -49,6 +52,14 @@ void Args(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h"})->Unit(benchmark::kMillisecond);
 }
 
+// One frame through the tracker; false (and the benchmark skipped) on an
+// error.
+bool Track(FaceTracker* t, const Scene& s, double time, FaceInfo* fi, benchmark::State& state) {
+  const Status st = t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, fi);
+  if (!st.ok()) state.SkipWithError(st.message().c_str());
+  return st.ok();
+}
+
 // The tracker for `s`; null (and the benchmark skipped) when it cannot be made.
 std::unique_ptr<FaceTracker> MakeTracker(const Scene& s, const FaceTrackerOptions& o,
                                          benchmark::State& state) {
@@ -68,10 +79,10 @@ void TrackAt30Fps(benchmark::State& state, const FaceTrackerOptions& o) {
   if (!t) return;
   FaceInfo fi;
   double time = 1.0;
-  t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);  // acquire
+  if (!Track(t.get(), s, time, &fi, state)) return;  // acquire
   for (auto _ : state) {
     time += 1.0 / 30;
-    t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
+    if (!Track(t.get(), s, time, &fi, state)) break;
   }
   state.counters["valid"] = fi.valid;
   state.counters["detected"] = fi.detected;
@@ -89,8 +100,8 @@ void BM_FaceDetectionMode(benchmark::State& state) {
   if (!t) return;
   FaceInfo fi;
   for (auto _ : state) {
-    t->reset();  // forces full-frame detection + landmarks
-    t->Process(s.frame, Time(FromSeconds(1.0)), nullptr, nullptr, &fi);
+    t->Reset();  // forces full-frame detection + landmarks
+    if (!Track(t.get(), s, 1.0, &fi, state)) break;
   }
   state.counters["valid"] = fi.valid;
 }
@@ -110,7 +121,7 @@ void BM_SmallFaceTracking(benchmark::State& state) {
   FaceInfo fi;
   double time = 1.0;
   for (int i = 0; i < 10 && !fi.valid; ++i, time += 1.0 / 30) {  // acquire
-    t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
+    if (!Track(t.get(), s, time, &fi, state)) return;
   }
   if (!fi.valid) {
     state.SkipWithError("the 30 px face was not acquired");
@@ -119,7 +130,7 @@ void BM_SmallFaceTracking(benchmark::State& state) {
   int valid = 0, n = 0;
   for (auto _ : state) {
     time += 1.0 / 30;
-    t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
+    if (!Track(t.get(), s, time, &fi, state)) break;
     valid += fi.valid ? 1 : 0;
     ++n;
   }
@@ -140,7 +151,7 @@ void BM_SearchWithNobodyInView(benchmark::State& state) {
   double time = 1.0, worst = 0.0;
   for (auto _ : state) {
     time += 1.0 / 30;
-    t->Process(s.frame, Time(FromSeconds(time)), nullptr, nullptr, &fi);
+    if (!Track(t.get(), s, time, &fi, state)) break;
     worst = std::max(worst, fi.timings.total_ms);
   }
   state.counters["worst_ms"] = worst;

@@ -30,7 +30,11 @@ BENCHMARK(BM_HeadSmoother);
 void BM_StabilizerPerFrame(benchmark::State& state) {
   const bool gyro_only = state.range(0) != 0;
   CameraModel m;
-  CameraModel::Create(IntrinsicsFromHorizontalFov(1280, 720, 1.2), CameraModelOptions(), &m);
+  if (!CameraModel::Create(IntrinsicsFromHorizontalFov(1280, 720, 1.2), CameraModelOptions(), &m)
+           .ok()) {
+    state.SkipWithError("no camera model");
+    return;
+  }
   sim::LandmarkSequenceOptions o;
   o.duration_s = 4.0;
   o.camera.shake_rms_rad = 0.012;
@@ -43,7 +47,10 @@ void BM_StabilizerPerFrame(benchmark::State& state) {
     std::unique_ptr<Stabilizer> stab;
     StabilizerOptions so;
     so.gyro_only = gyro_only;
-    Stabilizer::Create(m, OutputOptions(), so, &stab);
+    if (!Stabilizer::Create(m, OutputOptions(), so, &stab).ok()) {
+      state.SkipWithError("no stabilizer");
+      break;
+    }
     OrientationTimeline tl{OrientationTimelineOptions()};
     size_t g = 0;
     state.ResumeTiming();
@@ -53,7 +60,7 @@ void BM_StabilizerPerFrame(benchmark::State& state) {
         tl.AddSample(seq.gyro()[g++]);
       }
       StabilizerFrame out;
-      stab->Process(fr.stamp, tl, seq.timing(), &fr.observed, &out);
+      if (!stab->Process(fr.stamp, tl, seq.timing(), &fr.observed, &out).ok()) continue;
       solve_ms.push_back(out.solver.time_ms);
       total_ms.push_back(out.timings.total_ms);
       iterations.push_back(out.solver.iterations);

@@ -13,7 +13,14 @@
 namespace steadiface {
 namespace {
 
+// False (and the benchmark skipped) when `s` is an error.
+bool Ok(const Status& s, benchmark::State& state) {
+  if (!s.ok()) state.SkipWithError(s.message().c_str());
+  return s.ok();
+}
+
 struct Fixture {
+  Status status;  ///< of the set-up
   CameraModel model;
   std::unique_ptr<Warper> warper;
   cv::Mat input, output;
@@ -22,12 +29,13 @@ struct Fixture {
   Eigen::Vector2d t{0.01, -0.005};
 
   Fixture(int w, int h, int channels, int threads, bool direct = true) {
-    CameraModel::Create(IntrinsicsFromHorizontalFov(w, h, 1.2),
-                        CameraModelOptions(), &model);
+    status = CameraModel::Create(IntrinsicsFromHorizontalFov(w, h, 1.2), CameraModelOptions(),
+                                 &model);
     WarpOptions o;
     o.num_threads = threads;
     o.direct_sampling = direct;
-    Warper::Create(model, o, &warper);
+    if (status.ok()) status = Warper::Create(model, o, &warper);
+    if (!status.ok()) return;
     input.create(h, w, channels == 1 ? CV_8UC1 : CV_8UC3);
     cv::randu(input, cv::Scalar::all(0), cv::Scalar::all(255));
     // A rolling-shutter frame: 25 mrad of rotation over the readout.
@@ -37,7 +45,10 @@ struct Fixture {
     }
     RollingShutterOptions rs;
     rs.readout_time_s = 0.03;
-    RowRotations::Build(tl, RowTiming(rs, h), Time(FromSeconds(0.02)), 32, &rows);
+    if (RowRotations::Build(tl, RowTiming(rs, h), Time(FromSeconds(0.02)), 32, &rows) !=
+        QueryResult::kOk) {
+      status = Status::Error("no row rotations");
+    }
     R_v = rows.Middle() * ExpSO3(Eigen::Vector3d(0.005, -0.01, 0.002));
   }
 };
@@ -54,29 +65,34 @@ void Args(benchmark::internal::Benchmark* b) {
 
 void BM_Mesh(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
+  if (!Ok(f.status, state)) return;
   for (auto _ : state) {
-    f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+    if (!Ok(f.warper->ComputeMesh(f.R_v, f.t, f.rows), state)) break;
   }
 }
 
 void BM_Maps(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3), false);
-  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  if (!Ok(f.status, state) || !Ok(f.warper->ComputeMesh(f.R_v, f.t, f.rows), state)) return;
   for (auto _ : state) f.warper->BuildMaps();
 }
 
 void BM_Remap(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3), false);
-  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  if (!Ok(f.status, state) || !Ok(f.warper->ComputeMesh(f.R_v, f.t, f.rows), state)) return;
   f.warper->BuildMaps();
-  for (auto _ : state) f.warper->Remap(f.input, &f.output);
+  for (auto _ : state) {
+    if (!Ok(f.warper->Remap(f.input, &f.output), state)) break;
+  }
 }
 
 // The warp kernel: the mesh sampled directly (SampleMesh), no maps.
 void BM_DirectSample(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
-  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
-  for (auto _ : state) f.warper->Render(f.input, &f.output);
+  if (!Ok(f.status, state) || !Ok(f.warper->ComputeMesh(f.R_v, f.t, f.rows), state)) return;
+  for (auto _ : state) {
+    if (!Ok(f.warper->Render(f.input, &f.output), state)) break;
+  }
 }
 
 // The same mesh through the portable kernel only (SampleKernel::kPortable):
@@ -85,7 +101,7 @@ void BM_DirectSample(benchmark::State& state) {
 // counter "shuffle_share".
 void BM_DirectSamplePortable(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
-  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  if (!Ok(f.status, state) || !Ok(f.warper->ComputeMesh(f.R_v, f.t, f.rows), state)) return;
   const cv::Size out(f.warper->output_geometry().width(),
                      f.warper->output_geometry().height());
   SampleStats st;
@@ -102,13 +118,16 @@ void BM_DirectSamplePortable(benchmark::State& state) {
 // Mesh + direct sampling (the default).
 void BM_WarpEndToEnd(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
-  for (auto _ : state) f.warper->Warp(f.input, f.R_v, f.t, f.rows, &f.output);
+  if (!Ok(f.status, state)) return;
+  for (auto _ : state) {
+    if (!Ok(f.warper->Warp(f.input, f.R_v, f.t, f.rows, &f.output), state)) break;
+  }
 }
 
 // The floor: a bare cv::remap with precomputed float maps.
 void BM_BareRemapFloor(benchmark::State& state) {
   Fixture f(state.range(0), state.range(1), state.range(2), state.range(3));
-  f.warper->ComputeMesh(f.R_v, f.t, f.rows);
+  if (!Ok(f.status, state) || !Ok(f.warper->ComputeMesh(f.R_v, f.t, f.rows), state)) return;
   f.warper->BuildMaps();
   cv::Mat mx, my, m1, m2;
   f.warper->FloatMaps(&mx, &my);

@@ -103,7 +103,7 @@ TEST(EvaluationTest, UnknownMethodsAndPresetsAreRefused) {
 TEST(EvaluationTest, ViewOverridesChangeOnlyWhatTheyName) {
   PipelineOptions po, before;
   eval::ViewOverrides v;
-  eval::ApplyViewOverrides(v, &po);  // nothing set: nothing changes
+  ASSERT_TRUE(eval::ApplyViewOverrides(v, &po).ok());  // nothing set: nothing changes
   EXPECT_EQ(po.crop.mode, before.crop.mode);
   EXPECT_EQ(po.horizon.mode, before.horizon.mode);
   EXPECT_EQ(po.crop.widest_crop_ratio, before.crop.widest_crop_ratio);
@@ -111,12 +111,14 @@ TEST(EvaluationTest, ViewOverridesChangeOnlyWhatTheyName) {
   v.horizon = "lock";
   v.widest = 0.05;
   v.start_tight = true;
-  eval::ApplyViewOverrides(v, &po);
+  ASSERT_TRUE(eval::ApplyViewOverrides(v, &po).ok());
   EXPECT_EQ(po.crop.mode, CropMode::kDynamic);
   EXPECT_EQ(po.horizon.mode, HorizonMode::kLock);
   EXPECT_EQ(po.crop.widest_crop_ratio, 0.05);
   EXPECT_FALSE(po.crop.start_wide);
   EXPECT_EQ(po.crop.headroom, before.crop.headroom);
+  v.horizon = "sideways";
+  EXPECT_FALSE(eval::ApplyViewOverrides(v, &po).ok());
 }
 
 // The sweep's default grid pairs each permutation with one offset x

@@ -109,7 +109,7 @@ TEST(FaceTrackerTest, LandmarksAreEquivariantUnderKnownWarps) {
     cv::Mat warped;
     cv::warpPerspective(img, warped, k.H, img.size(), cv::INTER_LINEAR,
                         cv::BORDER_REPLICATE);
-    t->reset();
+    t->Reset();
     FaceInfo fi;
     ASSERT_TRUE(t->Process(warped, At(1.0), nullptr, nullptr, &fi).ok());
     ASSERT_TRUE(fi.valid) << k.name;

@@ -52,7 +52,7 @@ CheckRun Feed(const Eigen::Quaterniond& R_imu_cam, double clock_offset_s,
   for (int i = 0; i < sim->num_frames(); ++i) {
     cv::Mat frame;
     sim::SimTruth truth;
-    sim->Render(i, &frame, &truth);
+    EXPECT_TRUE(sim->Render(i, &frame, &truth).ok()) << i;
     // The gyro up to this frame's last row (as a live node waits for it).
     while (g < sim->imu().size() &&
            sim->imu()[g].stamp <=

@@ -88,7 +88,7 @@ TEST(GravityEstimatorTest, LeavesOutReadingsFarFromOneG) {
   EXPECT_FALSE(cam.gravity.Add(At(5.0), a, cam.timeline));
   EXPECT_FALSE(
       cam.gravity.Add(At(0.5), Eigen::Vector3d(NAN, 0, 0), cam.timeline));
-  cam.gravity.reset();
+  cam.gravity.Reset();
   EXPECT_FALSE(cam.gravity.valid());
 }
 

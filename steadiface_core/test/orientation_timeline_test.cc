@@ -331,7 +331,7 @@ TEST(OrientationTimelineTest, ResetStartsANewEpoch) {
   OrientationTimeline tl{OrientationTimelineOptions()};
   tl.AddSample({At(100.0), Eigen::Vector3d(1, 0, 0)});
   tl.AddSample({At(100.1), Eigen::Vector3d(1, 0, 0)});
-  tl.reset();
+  tl.Reset();
   EXPECT_TRUE(tl.empty());
   // Earlier stamps are accepted after the reset (time jumped back).
   EXPECT_EQ(tl.AddSample({At(1.0), Eigen::Vector3d::Zero()}),

@@ -217,7 +217,7 @@ TEST(SimulatorTest, RobotPresetSeesASmallFace) {
   for (int i : {0, 45, 89}) {
     cv::Mat frame;
     sim::SimTruth t;
-    s->Render(i, &frame, &t);
+    ASSERT_TRUE(s->Render(i, &frame, &t).ok()) << i;
     EXPECT_TRUE(t.head_in_view) << i;
     EXPECT_GT(t.face_scale_px, 28.0) << i;
     EXPECT_LT(t.face_scale_px, 40.0) << i;

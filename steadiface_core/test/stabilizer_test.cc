@@ -388,7 +388,7 @@ TEST(StabilizerTest, RejectsBadOptionsAndStamps) {
   EXPECT_TRUE(stab->Process(Time(FromSeconds(1.0)), tl, timing, nullptr, &f).ok());
   // Non-increasing stamp.
   EXPECT_FALSE(stab->Process(Time(FromSeconds(0.9)), tl, timing, nullptr, &f).ok());
-  stab->reset();
+  stab->Reset();
   EXPECT_TRUE(stab->Process(Time(FromSeconds(0.9)), tl, timing, nullptr, &f).ok());
   EXPECT_TRUE(f.flags.first_frame);
   // A face with NaN landmarks is ignored, not used.

@@ -78,7 +78,7 @@ TEST(SlowMotionFilterTest, ANonPositiveStepRestartsAtTheSample) {
   const Eigen::Vector2d x(-40.0, 7.0);
   EXPECT_EQ(f.Update(x, 0.0), x);
   EXPECT_EQ(f.velocity(), Eigen::Vector2d::Zero());
-  f.reset();
+  f.Reset();
   EXPECT_FALSE(f.started());
   EXPECT_EQ(f.Update(Eigen::Vector2d(1, 2), kDt), Eigen::Vector2d(1, 2));
 }

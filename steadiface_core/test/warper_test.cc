@@ -293,7 +293,7 @@ TEST(WarperTest, UndistortOnlyMatchesOpenCv) {
     o.fixed_point_maps = false;
     auto w = MakeWarper(m, o);
     const Eigen::Quaterniond R = Eigen::Quaterniond::Identity();
-    w->ComputeMesh(R, Eigen::Vector2d::Zero(), RowRotations(R, 480));
+    ASSERT_TRUE(w->ComputeMesh(R, Eigen::Vector2d::Zero(), RowRotations(R, 480)).ok());
     w->BuildMaps();
     cv::Mat mx, my;
     w->FloatMaps(&mx, &my);

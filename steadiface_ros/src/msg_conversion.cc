@@ -10,6 +10,7 @@
 
 #include "image_decoder.h"
 #include "steadiface_core/common/so3.h"
+#include "steadiface_core/face/landmarks68.h"
 #include "steadiface_ros/time_conversion.h"
 
 namespace steadiface_ros {
@@ -373,7 +374,7 @@ steadiface::Status FromMsg(const steadiface::FaceLandmarks& m, std::vector<Eigen
   points->clear();
   *confidence = std::isfinite(m.confidence) ? std::min(1.0f, std::max(0.0f, m.confidence)) : 0.0;
   if (!m.valid) return steadiface::Status::Ok();
-  if (m.points.size() != 68) {
+  if (m.points.size() != steadiface::landmarks68::kCount) {
     return steadiface::Status::Error("landmarks_in: need 68 points, got " +
                                      std::to_string(m.points.size()));
   }

@@ -287,7 +287,7 @@ void StabilizerRos::OnTimeJump() {
 }
 
 void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   const double since = (ros::WallTime::now() - last_imu_wall_).toSec();
   s.add("imu messages", w.counters.imu_in);
   s.add("imu rejected", w.counters.imu_rejected);
@@ -322,7 +322,7 @@ void StabilizerRos::DiagGyro(diagnostic_updater::DiagnosticStatusWrapper& s) {
 }
 
 void StabilizerRos::DiagRotationSource(diagnostic_updater::DiagnosticStatusWrapper& s) {
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   s.add("rotation_source", w.rotation_source);
   s.add("frames rotated from the video", w.counters.from_video);
   if (w.rotation_source == "imu" || (w.rotation_source == "auto" && !w.last_from_video)) {
@@ -349,7 +349,7 @@ void StabilizerRos::DiagRotationSource(diagnostic_updater::DiagnosticStatusWrapp
 
 void StabilizerRos::DiagView(diagnostic_updater::DiagnosticStatusWrapper& s) {
   // The crop and the level horizon as of the last frame.
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   const double deg = 180.0 / M_PI;
   s.add("crop", w.crop.dynamic ? "dynamic" : "fixed");
   s.add("kept width", 1.0 - 2.0 * w.crop.crop_ratio);
@@ -380,7 +380,7 @@ void StabilizerRos::DiagView(diagnostic_updater::DiagnosticStatusWrapper& s) {
 }
 
 void StabilizerRos::DiagExtrinsics(diagnostic_updater::DiagnosticStatusWrapper& s) {
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   using E = ExtrinsicsState;
   const std::string tf = "TF " + w.extrinsics_from + " -> " + w.extrinsics_to;
   s.add("imu frame", w.extrinsics_from);
@@ -406,7 +406,7 @@ void StabilizerRos::DiagExtrinsics(diagnostic_updater::DiagnosticStatusWrapper& 
 }
 
 void StabilizerRos::DiagFace(diagnostic_updater::DiagnosticStatusWrapper& s) {
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   s.add("state", steadiface::TrackingStateName(w.face_state));
   s.add("failure", w.face_failure);
   s.add("confidence", w.face_confidence);
@@ -427,7 +427,7 @@ void StabilizerRos::DiagFace(diagnostic_updater::DiagnosticStatusWrapper& s) {
 }
 
 void StabilizerRos::DiagSolver(diagnostic_updater::DiagnosticStatusWrapper& s) {
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   s.add("last termination", w.last_solver_termination);
   s.add("last iterations", w.last_solver_iterations);
   s.add("last time [ms]", w.last_solver_ms);
@@ -443,7 +443,7 @@ void StabilizerRos::DiagSolver(diagnostic_updater::DiagnosticStatusWrapper& s) {
 }
 
 void StabilizerRos::DiagFrames(diagnostic_updater::DiagnosticStatusWrapper& s) {
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   const WrapperCounters& c = w.counters;
   s.add("images in", c.images_in);
   s.add("frames out", c.frames_out);
@@ -466,7 +466,7 @@ void StabilizerRos::DiagFrames(diagnostic_updater::DiagnosticStatusWrapper& s) {
 }
 
 void StabilizerRos::DiagProtrusion(diagnostic_updater::DiagnosticStatusWrapper& s) {
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   s.add("binary searches", w.stabilizer.protrusion_searches);
   s.add("previous-warp fallbacks", w.stabilizer.previous_warp_fallbacks);
   s.add("frames with undefined pixels", w.stabilizer.undefined_frames);
@@ -480,7 +480,7 @@ void StabilizerRos::DiagProtrusion(diagnostic_updater::DiagnosticStatusWrapper& 
 }
 
 void StabilizerRos::DiagGyroVideo(diagnostic_updater::DiagnosticStatusWrapper& s) {
-  const WrapperStatus w = wrapper_->Status();
+  const WrapperStatus w = wrapper_->CurrentStatus();
   const steadiface::GyroVideoCheckResult& c = w.gyro_video_check;
   const Eigen::Quaterniond& q = c.best_R_cam_imu;
   char quat[96];

@@ -583,7 +583,7 @@ void StabilizerWrapper::UpdateStatus(const steadiface::PipelineFrame& frame,
   }
 }
 
-WrapperStatus StabilizerWrapper::Status() const {
+WrapperStatus StabilizerWrapper::CurrentStatus() const {
   WrapperStatus s = status_;
   s.counters = counters_;
   s.pipeline_ready = pipeline_ != nullptr;

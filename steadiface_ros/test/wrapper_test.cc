@@ -63,7 +63,7 @@ const Stream& TestStream() {
     Stream st;
     steadiface::sim::SimulatorOptions o;
     o.data_dir = STEADIFACE_TEST_DATA_DIR;
-    steadiface::sim::ApplyPreset("walk", &o);
+    EXPECT_TRUE(steadiface::sim::ApplyPreset("walk", &o).ok());
     o.width = 320;
     o.height = 180;
     o.duration_s = 2.0;
@@ -94,7 +94,7 @@ const Stream& TestStream() {
     for (int i = 0; i < sim->num_frames(); ++i) {
       cv::Mat f;
       steadiface::sim::SimTruth t;
-      sim->Render(i, &f, &t);
+      EXPECT_TRUE(sim->Render(i, &f, &t).ok()) << i;
       std_msgs::Header h;
       h.stamp = ToRosTime(t.stamp) + shift;
       h.frame_id = "cam";
@@ -163,7 +163,7 @@ TEST(WrapperTest, CleanStreamIsStabilizedFrameByFrame) {
   Feed(&w, TestStream());
   EXPECT_EQ(sink.states.size(), TestStream().images.size());
   EXPECT_EQ(sink.images.size(), TestStream().images.size());
-  EXPECT_EQ(w.Status().counters.extrapolated, 0u);
+  EXPECT_EQ(w.CurrentStatus().counters.extrapolated, 0u);
   ExpectAllFinite(sink);
   std::vector<ros::Time> stamps;
   for (const auto& t : sink.tf) {
@@ -245,14 +245,14 @@ TEST(WrapperTest, LateImuExtrinsicsAreTakenWhenTfHasThem) {
   };
   StabilizerWrapper w(Options(), WrapperOptions(), &sink, lookup);
   Feed(&w, rotated, 0, 10);
-  EXPECT_EQ(w.Status().extrinsics, ExtrinsicsState::kWaitingForTf);
+  EXPECT_EQ(w.CurrentStatus().extrinsics, ExtrinsicsState::kWaitingForTf);
   EXPECT_GT(sink.warnings["extrinsics"], 0);
   Feed(&w, rotated, 10);
-  EXPECT_EQ(w.Status().extrinsics, ExtrinsicsState::kFromTf);
+  EXPECT_EQ(w.CurrentStatus().extrinsics, ExtrinsicsState::kFromTf);
   EXPECT_EQ(asked, 21);  // asked on every frame until it came, then never again
   EXPECT_EQ(asked_from, "imu");
   EXPECT_EQ(asked_to, "cam");
-  EXPECT_EQ(w.Status().counters.rebuilds, 1u);
+  EXPECT_EQ(w.CurrentStatus().counters.rebuilds, 1u);
   StabilizerWrapper truth(Options(), WrapperOptions(), &truth_sink);
   Feed(&truth, TestStream());
   ASSERT_EQ(sink.states.size(), truth_sink.states.size());
@@ -292,11 +292,11 @@ TEST(WrapperTest, MissingLandmarkModelFallsBackToGyroOnly) {
   Feed(&missing, TestStream());
   EXPECT_EQ(missing_sink.errors["landmark_model"], 1);
   EXPECT_EQ(missing_sink.errors.count("pipeline"), 0u);
-  const std::string why = missing.Status().landmark_model_error;
+  const std::string why = missing.CurrentStatus().landmark_model_error;
   EXPECT_NE(why.find("/nonexistent/shape_predictor_68_face_landmarks.dat"),
             std::string::npos);
   EXPECT_NE(why.find("apt-get install libdlib-data"), std::string::npos) << why;
-  EXPECT_TRUE(off.Status().landmark_model_error.empty());
+  EXPECT_TRUE(off.CurrentStatus().landmark_model_error.empty());
   ASSERT_EQ(missing_sink.states.size(), TestStream().images.size());
   ASSERT_EQ(off_sink.states.size(), missing_sink.states.size());
   for (size_t i = 0; i < off_sink.states.size(); ++i) {
@@ -375,7 +375,7 @@ TEST(WrapperTest, PipelinedPublishesTheSameFramesInOrder) {
       EXPECT_EQ(b.states[i].virtual_rotation.w, a.states[i].virtual_rotation.w);
     }
     ASSERT_EQ(b.tf.size(), a.tf.size());
-    EXPECT_EQ(wb.Status().counters.frames_out, wa.Status().counters.frames_out);
+    EXPECT_EQ(wb.CurrentStatus().counters.frames_out, wa.CurrentStatus().counters.frames_out);
   }
   // A frame with no successor is published once the hold runs out.
   Sink c;
@@ -591,7 +591,7 @@ TEST(WrapperTest, ImuFaultsAreRejectedCountedAndHarmless) {
     if (k % 29 == 0) m->header.stamp -= ros::Duration(0.0001);  // out of order
     if (k % 31 == 0) m->angular_velocity.z = 1e4;               // implausible
   });
-  const WrapperStatus s = w.Status();
+  const WrapperStatus s = w.CurrentStatus();
   EXPECT_GT(s.counters.imu_rejected, 20u);
   EXPECT_GT(s.timeline.count(steadiface::SampleResult::kNonFinite), 10u);
   EXPECT_GT(s.timeline.count(steadiface::SampleResult::kImplausibleRate), 3u);
@@ -619,7 +619,7 @@ TEST(WrapperTest, ImuGapIsWarnedAndFramesExtrapolatedOrDropped) {
       if (m->header.stamp > gap_from && m->header.stamp < gap_to)
         m->angular_velocity.x = kNaN;
     });
-    const WrapperStatus s = w.Status();
+    const WrapperStatus s = w.CurrentStatus();
     EXPECT_GT(s.counters.imu_gaps, 0u);
     if (policy == steadiface::LateFramePolicy::kExtrapolate) {
       EXPECT_GT(s.counters.extrapolated + s.counters.dropped_no_gyro, 0u);
@@ -646,7 +646,7 @@ TEST(WrapperTest, NoImuPassesFramesThroughUnstabilized) {
   w.Flush();
   EXPECT_EQ(sink.images.size(), st.images.size());
   EXPECT_TRUE(sink.states.empty());
-  EXPECT_EQ(w.Status().counters.passthrough, st.images.size());
+  EXPECT_EQ(w.CurrentStatus().counters.passthrough, st.images.size());
   EXPECT_GT(sink.errors["no_imu"], 0);
   // Or dropped, when configured so.
   Sink sink2;
@@ -656,7 +656,7 @@ TEST(WrapperTest, NoImuPassesFramesThroughUnstabilized) {
   for (const auto& img : st.images) w2.OnImage(img, st.info, img->header.stamp);
   w2.Flush();
   EXPECT_TRUE(sink2.images.empty());
-  EXPECT_EQ(w2.Status().counters.dropped_no_gyro, st.images.size());
+  EXPECT_EQ(w2.CurrentStatus().counters.dropped_no_gyro, st.images.size());
 }
 
 // rotation_source visual: no IMU message at all, yet every frame is
@@ -689,13 +689,13 @@ TEST(WrapperTest, WithoutAnImuTheVideoGivesTheRotation) {
   w.Flush();
   ASSERT_EQ(sink.states.size(), st.images.size());
   EXPECT_EQ(sink.images.size(), st.images.size());
-  EXPECT_EQ(w.Status().counters.passthrough, 0u);
+  EXPECT_EQ(w.CurrentStatus().counters.passthrough, 0u);
   EXPECT_EQ(sink.errors["no_imu"], 0);
-  EXPECT_EQ(w.Status().rotation_source, "visual");
-  EXPECT_TRUE(w.Status().last_from_video);
-  EXPECT_EQ(w.Status().counters.from_video, st.images.size());
-  EXPECT_TRUE(w.Status().visual.valid);
-  EXPECT_GE(w.Status().visual.inliers, 20);
+  EXPECT_EQ(w.CurrentStatus().rotation_source, "visual");
+  EXPECT_TRUE(w.CurrentStatus().last_from_video);
+  EXPECT_EQ(w.CurrentStatus().counters.from_video, st.images.size());
+  EXPECT_TRUE(w.CurrentStatus().visual.valid);
+  EXPECT_GE(w.CurrentStatus().visual.inliers, 20);
   ExpectAllFinite(sink);
   const std::vector<double> a = turns(sink), b = turns(imu_sink);
   ASSERT_EQ(a.size(), b.size());
@@ -728,7 +728,7 @@ TEST(WrapperTest, AutoBridgesAnImuDropoutWithTheVideo) {
       if (dropout && t > 0.6 && t < 1.2)
         m->angular_velocity.x = kNaN;  // lost: rejected
     });
-    return w.Status();
+    return w.CurrentStatus();
   };
   Sink imu, healthy;
   run(steadiface::RotationSource::kImu, false, &imu);
@@ -822,7 +822,7 @@ TEST(WrapperTest, BadImagesAreDroppedWithAReason) {
     }
     return m;
   });
-  const WrapperStatus s = w.Status();
+  const WrapperStatus s = w.CurrentStatus();
   EXPECT_EQ(s.counters.dropped_bad_image, 6u);  // 5, 6, 7, 8, 9, 11
   EXPECT_EQ(sink.states.size(), st.images.size() - 6);
   EXPECT_GT(sink.errors["image"], 0);
@@ -867,7 +867,7 @@ TEST(WrapperTest, CameraInfoMissingOrChangingIsHandled) {
     w.OnTimer(st.images[i]->header.stamp);
   }
   w.Flush();
-  const WrapperStatus s = w.Status();
+  const WrapperStatus s = w.CurrentStatus();
   EXPECT_EQ(s.counters.dropped_bad_info, 2u);
   EXPECT_EQ(s.counters.rebuilds, 1u);
   EXPECT_EQ(sink.images.back()->width, st.info->width / 2);
@@ -884,7 +884,7 @@ TEST(WrapperTest, BurstsBeyondTheQueueAreBoundedAndCounted) {
   const Stream& st = TestStream();
   // A burst of 30 frames before any IMU arrives, and no time passing.
   for (int i = 0; i < 30; ++i) w.OnImage(st.images[i], st.info, ros::Time(1.0));
-  EXPECT_EQ(w.Status().counters.dropped_queue_full, 25u);
+  EXPECT_EQ(w.CurrentStatus().counters.dropped_queue_full, 25u);
   for (const auto& m : st.imu) w.OnImu(m);
   w.Flush();
   EXPECT_EQ(sink.states.size(), 5u);
@@ -899,7 +899,7 @@ TEST(WrapperTest, TimeJumpBackResetsAndTheSecondPassMatchesTheFirst) {
   const size_t n = sink.states.size();
   Feed(&w, st);
   ASSERT_EQ(sink.states.size(), 2 * n);
-  EXPECT_EQ(w.Status().counters.time_jumps, 1u);
+  EXPECT_EQ(w.CurrentStatus().counters.time_jumps, 1u);
   for (size_t i = 0; i < n; ++i) {
     const auto& a = sink.states[i];
     const auto& b = sink.states[n + i];
@@ -964,7 +964,7 @@ TEST(WrapperTest, TheViewReachesTheStateAndCameraInfo) {
                 1e-6 * fx0)
         << i;
   }
-  const WrapperStatus st = w.Status();
+  const WrapperStatus st = w.CurrentStatus();
   EXPECT_EQ(st.horizon_mode, "level");
   EXPECT_TRUE(st.horizon.active);
   // The walk's bob (2.6 m/s^2 at 1.8 Hz) puts many readings beyond 10 % of
@@ -981,9 +981,9 @@ TEST(WrapperTest, TheViewReachesTheStateAndCameraInfo) {
     m->linear_acceleration.x = m->linear_acceleration.y =
         m->linear_acceleration.z = 0.0;
   });
-  EXPECT_FALSE(w2.Status().horizon.active);
-  EXPECT_EQ(w2.Status().horizon.inactive_reason, "no accelerometer");
-  EXPECT_EQ(w2.Status().counters.accel_in, 0u);
+  EXPECT_FALSE(w2.CurrentStatus().horizon.active);
+  EXPECT_EQ(w2.CurrentStatus().horizon.inactive_reason, "no accelerometer");
+  EXPECT_EQ(w2.CurrentStatus().counters.accel_in, 0u);
   EXPECT_EQ(bare.states.size(), TestStream().images.size());
 }
 

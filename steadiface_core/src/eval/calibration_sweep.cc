@@ -66,7 +66,8 @@ Status RunSweepJob(const CalibrationSweepOptions& o, const SweepJob& j, Calibrat
                    Eigen::Quaterniond* mounting) {
   sim::SimulatorOptions so;
   so.data_dir = o.data_dir;
-  sim::ApplyPreset("walk", &so);
+  Status st = sim::ApplyPreset("walk", &so);
+  if (!st.ok()) return st;
   const bool mono = j.format.find("mono") != std::string::npos;
   if (!ParseFormat(j.format, &so.width, &so.height)) {
     return Status::Error("format '" + j.format + "' is not WxH[mono]");
@@ -76,7 +77,7 @@ Status RunSweepJob(const CalibrationSweepOptions& o, const SweepJob& j, Calibrat
   so.imu_clock_offset_s = j.offset_s;
   so.seed = j.seed;
   std::unique_ptr<sim::Simulator> sim;
-  Status st = sim::Simulator::Create(so, &sim);
+  st = sim::Simulator::Create(so, &sim);
   if (!st.ok()) return st;
   *mounting = (GyroVideoCheck::SignedAxisPermutations()[j.permutation] *
                Eigen::Quaterniond(Eigen::AngleAxisd(o.tilt_deg * M_PI / 180.0,

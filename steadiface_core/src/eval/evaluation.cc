@@ -96,11 +96,13 @@ Method MethodFromName(const std::string& base) {
 
 // One method's pipeline options: its defaults for the simulator, then the
 // evaluation's overrides.
-PipelineOptions PipelineOptionsFor(const EvaluationOptions& o, const sim::Simulator& sim,
-                                   Method m) {
-  PipelineOptions po = OptionsFor(sim, m);
+Status PipelineOptionsFor(const EvaluationOptions& o, const sim::Simulator& sim, Method m,
+                          PipelineOptions* out) {
+  PipelineOptions& po = *out;
+  po = OptionsFor(sim, m);
   if (std::isfinite(o.crop)) po.warp.output.crop_ratio = o.crop;
-  ApplyViewOverrides(o.view, &po);
+  const Status view = ApplyViewOverrides(o.view, &po);
+  if (!view.ok()) return view;
   if (std::isfinite(o.search_interval_s)) po.face.search_interval_s = o.search_interval_s;
   if (o.visual_rotation) po.rotation_source = RotationSource::kVisual;
   if (std::isfinite(o.head_w_stay)) po.stabilizer.head.w_stay = o.head_w_stay;
@@ -114,7 +116,7 @@ PipelineOptions PipelineOptionsFor(const EvaluationOptions& o, const sim::Simula
   po.composite = o.composite;
   po.imu.imu_time_offset_s += o.offset_error_s;
   po.shutter.readout_time_s = std::max(0.0, po.shutter.readout_time_s + o.readout_error_s);
-  return po;
+  return Status::Ok();
 }
 
 // One preset: its simulator, the lossless input the ffmpeg peers read (made
@@ -224,9 +226,10 @@ double FaceFraction(Method m, const std::vector<StabilizerFrame>& frames) {
 Status PresetRun::RunPipeline(const std::string& name, Method m, bool video, VideoScorer* vs,
                               Score* sc, RunFigures* run,
                               std::vector<std::pair<std::string, std::string>>* composite_rows) {
-  const PipelineOptions po = PipelineOptionsFor(o_, *sim_, m);
+  PipelineOptions po;
+  Status s = PipelineOptionsFor(o_, *sim_, m, &po);
   std::unique_ptr<Scorecard> card;
-  Status s = MakeScorecard(*sim_, po, &card);
+  if (s.ok()) s = MakeScorecard(*sim_, po, &card);
   if (!s.ok()) return s;
   std::unique_ptr<FrameAverager> avg;
   if (o_.average_at >= 0 && !video) {
@@ -284,14 +287,17 @@ Status PresetRun::Run(const std::string& name, Score* sc, RunFigures* run, bool*
 
 }  // namespace
 
-void ApplyViewOverrides(const ViewOverrides& v, PipelineOptions* po) {
+Status ApplyViewOverrides(const ViewOverrides& v, PipelineOptions* po) {
   auto set = [](double flag, double* field) {
     if (std::isfinite(flag)) *field = flag;
   };
   if (v.crop_mode >= 0) {
     po->crop.mode = v.crop_mode == 1 ? CropMode::kDynamic : CropMode::kFixed;
   }
-  if (!v.horizon.empty()) ParseHorizonMode(v.horizon, &po->horizon.mode);
+  if (!v.horizon.empty()) {
+    const Status s = ParseHorizonMode(v.horizon, &po->horizon.mode);
+    if (!s.ok()) return s;
+  }
   if (v.start_tight) po->crop.start_wide = false;
   set(v.widest, &po->crop.widest_crop_ratio);
   set(v.level_weight, &po->horizon.level_weight);
@@ -303,6 +309,7 @@ void ApplyViewOverrides(const ViewOverrides& v, PipelineOptions* po) {
   set(v.widen_rate, &po->crop.max_widen_rate);
   set(v.tighten_rate, &po->crop.max_tighten_rate);
   set(v.zoom_accel, &po->crop.max_widen_accel);
+  return Status::Ok();
 }
 
 int RunEvaluation(const EvaluationOptions& o, std::ostream& out, std::ostream& err) {

@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/face/landmarks68.h"
+
 namespace steadiface {
 namespace {
 
@@ -38,14 +40,16 @@ constexpr double kRegionSpread = 0.35;
 bool FaceTracker::AlignedPatch(const cv::Mat& gray,
                                const std::vector<Eigen::Vector2d>& lm,
                                cv::Mat* patch, cv::Mat* A_out) const {
-  if (lm.size() != 68) return false;
+  if (lm.size() != landmarks68::kCount) return false;
   auto mean_of = [&lm](int a, int b) -> Eigen::Vector2d {
     Eigen::Vector2d c = Eigen::Vector2d::Zero();
     for (int i = a; i <= b; ++i) c += lm[i];
     return c / (b - a + 1);
   };
-  const Eigen::Vector2d eye_r = mean_of(36, 41), eye_l = mean_of(42, 47),
-                        mouth = mean_of(48, 59);
+  namespace l68 = landmarks68;
+  const Eigen::Vector2d eye_r = mean_of(l68::kRightEyeFirst, l68::kRightEyeLast),
+                        eye_l = mean_of(l68::kLeftEyeFirst, l68::kLeftEyeLast),
+                        mouth = mean_of(l68::kMouthFirst, l68::kMouthLast);
   const float P = static_cast<float>(options_.appearance_patch_px);
   const cv::Point2f src[3] = {cv::Point2f(eye_r.x(), eye_r.y()),
                               cv::Point2f(eye_l.x(), eye_l.y()),

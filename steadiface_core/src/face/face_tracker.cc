@@ -10,6 +10,7 @@
 #include "steadiface_core/camera/lens_distortion.h"
 #include "steadiface_core/common/grey.h"
 #include "steadiface_core/face/head_pose.h"
+#include "steadiface_core/face/landmarks68.h"
 #include "steadiface_core/face/upsampled_fit.h"
 
 namespace steadiface {
@@ -142,7 +143,7 @@ FaceTracker::FaceTracker(const CameraModel& model,
                          const FaceTrackerOptions& options)
     : model_(model), options_(options) {}
 
-void FaceTracker::reset() {
+void FaceTracker::Reset() {
   state_ = TrackingState::kSearching;
   if (schedule_) schedule_->Restart();
   last_landmarks_.clear();
@@ -218,7 +219,7 @@ bool FaceTracker::Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiri
   FaceFailure fail = FaceFailure::kNone;
   double score_sum = 0.0;
   int n_scores = 0;
-  if (c.landmarks.size() != 68 || !AllFinite(c.landmarks)) {
+  if (c.landmarks.size() != landmarks68::kCount || !AllFinite(c.landmarks)) {
     fail = FaceFailure::kBadInput;
   }
   const Eigen::Vector2d centre = Mean(c.landmarks);
@@ -228,8 +229,11 @@ bool FaceTracker::Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiri
   // basic symmetry: eyes above the mouth, left-right ordered).
   if (fail == FaceFailure::kNone) {
     const auto& lm = c.landmarks;
-    const bool ordered = lm[36].x() < lm[45].x() && lm[27].y() < lm[57].y() &&
-                         lm[0].x() < lm[16].x() && lm[48].x() < lm[54].x();
+    namespace l68 = landmarks68;
+    const bool ordered = lm[l68::kRightEyeOuter].x() < lm[l68::kLeftEyeOuter].x() &&
+                         lm[l68::kNoseBridgeTop].y() < lm[l68::kLowerLipBottom].y() &&
+                         lm[l68::kJawRightEnd].x() < lm[l68::kJawLeftEnd].x() &&
+                         lm[l68::kMouthRight].x() < lm[l68::kMouthLeft].x();
     info->shape_residual = acquiring || reference_shape_.empty()
                                ? 0.0
                                : ProcrustesResidual(Normalize(lm), reference_shape_);
@@ -416,7 +420,7 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
 
   if (state_ == TrackingState::kLost &&
       ToSeconds(stamp - last_seen_) > options_.lost_timeout_s) {
-    reset();
+    Reset();
   }
   // While searching, the whole frame once per search_interval_s and a
   // small-face tile in between (face/search_schedule.h).
@@ -450,7 +454,8 @@ void FaceTracker::Search(const cv::Mat& gray, const SearchStep& step, Time stamp
   bool ok = false;
   const auto t0 = Clock::now();
   std::vector<FaceBox> faces;
-  detector_->Detect(gray, step.roi, &faces, step.scale);
+  // A region the detector refuses (outside the frame) finds no face.
+  if (!detector_->Detect(gray, step.roi, &faces, step.scale).ok()) faces.clear();
   info->timings.detect_ms += MsSince(t0);
   info->detected = true;
   for (const FaceBox& f : faces) {  // largest first
@@ -550,14 +555,14 @@ Status FaceTracker::ProcessExternal(const std::vector<Eigen::Vector2d>& lm,
   const auto t_start = Clock::now();
   *info = FaceInfo();
   info->state = state_;
-  if (!lm.empty() && (lm.size() != 68 || !AllFinite(lm))) {
+  if (!lm.empty() && (lm.size() != landmarks68::kCount || !AllFinite(lm))) {
     MarkFailure(FaceFailure::kBadInput, stamp, info);
     return Status::Error("face: external landmarks must be 68 finite points, got " +
                          std::to_string(lm.size()));
   }
   if (state_ == TrackingState::kLost &&
       ToSeconds(stamp - last_seen_) > options_.lost_timeout_s) {
-    reset();
+    Reset();
   }
   bool rot_ok = false;
   const Eigen::Quaterniond R_now = MidRotation(stamp, timeline, timing, &rot_ok);

@@ -6,6 +6,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "steadiface_core/face/generic_face.h"
+#include "steadiface_core/face/landmarks68.h"
 
 namespace steadiface {
 
@@ -14,9 +15,10 @@ std::vector<Eigen::Vector3d> BuildHeadModel(
   const auto& generic = GenericFace68();
   if (mean_shape.size() != generic.size()) return generic;
   Eigen::Vector2d eyes = Eigen::Vector2d::Zero();
-  for (int i = 36; i < 48; ++i) eyes += mean_shape[i];
+  namespace l68 = landmarks68;
+  for (int i = l68::kRightEyeFirst; i <= l68::kLeftEyeLast; ++i) eyes += mean_shape[i];
   eyes /= 12.0;
-  const double jaw = (mean_shape[16] - mean_shape[0]).norm();
+  const double jaw = (mean_shape[l68::kJawLeftEnd] - mean_shape[l68::kJawRightEnd]).norm();
   const double s = jaw > 1e-9 ? 0.14 / jaw : 1.0;
   std::vector<Eigen::Vector3d> out(generic.size());
   for (size_t i = 0; i < generic.size(); ++i) {
@@ -45,7 +47,8 @@ bool EstimateHeadPose(const std::vector<Eigen::Vector3d>& model,
   const cv::Matx33d K(k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1);
   cv::Vec3d rvec, tvec;
   // Start facing the camera at a plausible distance.
-  const double w = std::abs(landmarks_px[16].x() - landmarks_px[0].x());
+  const double w = std::abs(landmarks_px[landmarks68::kJawLeftEnd].x() -
+                            landmarks_px[landmarks68::kJawRightEnd].x());
   tvec = cv::Vec3d(0, 0, w > 1 ? k.fx * 0.14 / w : 0.5);
   rvec = cv::Vec3d(0, 0, 0);
   bool ok = false;

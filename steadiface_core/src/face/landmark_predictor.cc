@@ -16,6 +16,7 @@
 
 #include "face/landmark_predictor_impl.h"
 #include "steadiface_core/common/model_cache.h"
+#include "steadiface_core/face/landmarks68.h"
 
 namespace steadiface {
 
@@ -108,7 +109,7 @@ void RememberLoaded(const std::string& path, const std::shared_ptr<const Impl>& 
 }
 
 bool Consistent(const Impl& m) {
-  return m.num_parts() == 68 && m.forests.size() == m.anchor_idx.size() &&
+  return m.num_parts() == landmarks68::kCount && m.forests.size() == m.anchor_idx.size() &&
          m.forests.size() == m.deltas.size();
 }
 
@@ -156,7 +157,7 @@ Status ReadDlibModel(const std::string& path, Impl* m) {
     return Status::Error("landmark model '" + path + "' is not a valid dlib shape predictor (" +
                          e.what() + ")" + kModelHint);
   }
-  if (m->num_parts() != 68) {
+  if (m->num_parts() != landmarks68::kCount) {
     return Status::Error("landmark model '" + path + "' predicts " +
                          std::to_string(m->num_parts()) +
                          " points; steadiface needs the 68-point model" + kModelHint);

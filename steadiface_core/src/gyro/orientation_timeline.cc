@@ -243,7 +243,7 @@ bool OrientationTimeline::MeanAngularSpeed(Time t0_cam, Time t1_cam,
   return true;
 }
 
-void OrientationTimeline::reset() {
+void OrientationTimeline::Reset() {
   samples_.clear();
   ++stats_.resets;
 }

@@ -159,7 +159,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
     d_previous_.setZero();
     e_previous_.setZero();
     has_previous_ = true;
-    offset_lowpass_.reset();
+    offset_lowpass_.Reset();
     r.solve_ms = 0.0;
     // The background layer's own cells (one global warp).
     MeasureCells(*source, &r);

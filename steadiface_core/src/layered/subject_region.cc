@@ -6,6 +6,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/face/landmarks68.h"
+
 namespace steadiface {
 namespace {
 
@@ -27,9 +29,11 @@ double BoxDistance(const Eigen::Vector2d& p, double x0, double x1, double y0,
   return outside + std::min(std::max(dx, dy), 0.0);
 }
 
-// 68-point landmark indices (iBUG 300-W): jaw 0-16, chin 8, brows 17-26.
-constexpr int kJawFirst = 0, kJawLast = 16, kChin = 8, kBrowFirst = 17,
-              kBrowLast = 26;
+using landmarks68::kBrowFirst;
+using landmarks68::kBrowLast;
+using landmarks68::kChin;
+using landmarks68::kJawFirst;
+using landmarks68::kJawLast;
 
 }  // namespace
 
@@ -130,14 +134,14 @@ SubjectRegion SubjectRegionTracker::Measure(const CameraModel& model,
   // This frame's head ellipse from the landmarks (invalid without them).
   const SubjectRegionOptions& o = options_;
   SubjectRegion measured;
-  if (face != nullptr && face->valid && face->landmarks.size() == 68 &&
+  if (face != nullptr && face->valid && face->landmarks.size() == landmarks68::kCount &&
       !rows.empty()) {
     // Landmarks into the output through the subject layer's pose, each at
     // its own row's real rotation.
-    std::vector<Eigen::Vector2d> out(68);
+    std::vector<Eigen::Vector2d> out(landmarks68::kCount);
     bool ok = true;
-    for (int i = 0; i < 68 && ok; ++i) {
-      const double row = face->landmark_rows.size() == 68
+    for (int i = 0; i < landmarks68::kCount && ok; ++i) {
+      const double row = face->landmark_rows.size() == landmarks68::kCount
                              ? face->landmark_rows[i]
                              : 0.5 * (rows.height() - 1);
       Eigen::Vector2d V;
@@ -168,7 +172,7 @@ SubjectRegion SubjectRegionTracker::Measure(const CameraModel& model,
             Eigen::Vector2d(o.head_width_scale * w, 0.5 * (bottom - top));
         Eigen::Vector2d c = Eigen::Vector2d::Zero();
         for (const auto& q : out) c += q;
-        measured.face_centre = c / 68.0;
+        measured.face_centre = c / static_cast<double>(landmarks68::kCount);
       }
     }
   }

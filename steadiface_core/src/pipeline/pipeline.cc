@@ -485,7 +485,7 @@ Status Pipeline::VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f) {
   // it. kAuto continues the gyro's timeline (the owner resets the stream
   // when time runs back).
   const bool visual_only = options_.rotation_source == RotationSource::kVisual;
-  if (visual_only && !timeline_.empty() && timeline_.newest() >= first_row) timeline_.reset();
+  if (visual_only && !timeline_.empty() && timeline_.newest() >= first_row) timeline_.Reset();
   if (timeline_.empty() || !has_visual_mid_) {
     if (timeline_.empty()) {
       timeline_.AddOrientation(first_row - FromSeconds(1e-3), Eigen::Quaterniond::Identity(),
@@ -525,14 +525,14 @@ Status Pipeline::VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f) {
 }
 
 void Pipeline::Reset() {
-  timeline_.reset();
+  timeline_.Reset();
   if (visual_ != nullptr) visual_->Reset();
   has_visual_mid_ = false;
-  if (tracker_ != nullptr) tracker_->reset();
-  stabilizer_->reset();
+  if (tracker_ != nullptr) tracker_->Reset();
+  stabilizer_->Reset();
   if (check_ != nullptr) check_->Reset();
-  region_->reset();
-  warper_->reset();
+  region_->Reset();
+  warper_->Reset();
   if (compositor_ != nullptr) compositor_->Reset();
   has_last_stamp_ = false;
   // A new epoch starts from the configuration: a replayed bag (rosbag play
@@ -541,9 +541,9 @@ void Pipeline::Reset() {
   timeline_.set_offset_correction(0.0);
   has_check_stamp_ = false;
   crop_.reset(new DynamicCrop(options_.crop, options_.warp.output.crop_ratio));
-  shake_path_.reset();
+  shake_path_.Reset();
   has_crop_stamp_ = false;
-  gravity_.reset();
+  gravity_.Reset();
 }
 
 }  // namespace steadiface

@@ -14,7 +14,7 @@ double SmoothStep(double x, double lo, double hi) {
 DynamicWeights::DynamicWeights(const DynamicWeightOptions& options)
     : options_(options) {}
 
-void DynamicWeights::reset() {
+void DynamicWeights::Reset() {
   initialized_ = false;
   history_.clear();
   fit_pose_ = fit_gyro_ = fit_var_ = 1.0;

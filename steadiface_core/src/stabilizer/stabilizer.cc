@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "steadiface_core/common/so3.h"
+#include "steadiface_core/face/landmarks68.h"
 #include "steadiface_core/stabilizer/face_in_camera.h"
 #include "stabilizer/pose_problem.h"
 
@@ -98,13 +99,13 @@ void Stabilizer::SetCropRatio(double r) {
   protrusion_ = ProtrusionGeometry(model_, output_, options_.terms.protrusion_samples_per_edge);
 }
 
-void Stabilizer::reset() {
+void Stabilizer::Reset() {
   subject_ = LayerState();
   reach_limit_ = 0.0;
   background_ = LayerState();
   has_held_face_ = false;
-  dynamic_.reset();
-  background_dynamic_.reset();
+  dynamic_.Reset();
+  background_dynamic_.Reset();
   reach_anchor_fed_ = false;
   ++stats_.resets;
 }
@@ -349,7 +350,9 @@ void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, double d
   if (!FaceInCamera(model_, face, f->rows, f->R_r, f->background.R_v, f->background.t, &seen)) {
     return;
   }
-  const double jaw = seen.landmarks.size() == 68 ? (seen.landmarks[0] - seen.landmarks[16]).norm()
+  const double jaw = seen.landmarks.size() == landmarks68::kCount
+                         ? (seen.landmarks[landmarks68::kJawRightEnd] -
+                            seen.landmarks[landmarks68::kJawLeftEnd]).norm()
                                                  : 2.0 * seen.scale;
   const double fraction = reach_limit_ > 0.0 ? std::min(options_.subject_reach, reach_limit_)
                                               : options_.subject_reach;
@@ -362,7 +365,7 @@ void Stabilizer::HoldWithinBackgroundReach(const FaceObservation& face, double d
     // the rest of the reach is left for the face's fast motion, which H
     // does not follow. A face that appears or comes back restarts S at its
     // position (no jump: H starts there too).
-    if (!fed) reach_anchor_.reset();
+    if (!fed) reach_anchor_.Reset();
     const Eigen::Vector2d S = reach_anchor_.Update(seen.centre, fed ? dt : 0.0);
     reach_anchor_fed_ = true;
     reach_anchor_frame_ = stats_.frames;

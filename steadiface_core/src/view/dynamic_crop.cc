@@ -68,7 +68,7 @@ DynamicCrop::DynamicCrop(const DynamicCropOptions& options, double tightest)
       r_(options.mode == CropMode::kDynamic && options.start_wide ? widest_
                                                                   : tightest) {}
 
-void DynamicCrop::reset() {
+void DynamicCrop::Reset() {
   needs_.clear();
   has_time_ = false;
   rate_ = 0.0;

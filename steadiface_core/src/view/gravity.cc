@@ -97,7 +97,7 @@ bool GravityEstimator::Add(Time t, const Eigen::Vector3d& a_cam,
   return true;
 }
 
-void GravityEstimator::reset() {
+void GravityEstimator::Reset() {
   up_ = smooth_ = Eigen::Vector3d(0.0, -1.0, 0.0);
   smooth_rate_.setZero();
   has_time_ = false;

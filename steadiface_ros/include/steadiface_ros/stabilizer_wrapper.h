@@ -183,7 +183,9 @@ class StabilizerWrapper {
   /// restarts the layered warp's smoothing).
   void RequestLayering(steadiface::WarpMode mode, const steadiface::LayeredWarpOptions& layered);
 
-  WrapperStatus Status() const;
+  /// Counters, the stabilizer's and the IMU's health, as of now (for the
+  /// diagnostics, the bag report and tests).
+  WrapperStatus CurrentStatus() const;
   const steadiface::PipelineOptions& pipeline_options() const { return options_; }
 
  private:

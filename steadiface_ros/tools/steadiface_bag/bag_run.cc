@@ -55,7 +55,7 @@ std::future<std::unique_ptr<steadiface::LandmarkPredictor>> PreloadLandmarks(
   if (po.landmark_source == steadiface::LandmarkSource::kNone) return {};
   return std::async(std::launch::async, [path = po.face.landmark_model_path] {
     std::unique_ptr<steadiface::LandmarkPredictor> model;
-    steadiface::LandmarkPredictor::Load(path, &model);
+    if (!steadiface::LandmarkPredictor::Load(path, &model).ok()) model.reset();
     return model;
   });
 }
@@ -273,7 +273,7 @@ Status BagRun::Run() {
       return Status::Error("cannot rename " + out_tmp_);
     }
   }
-  status_ = wrapper_->Status();
+  status_ = wrapper_->CurrentStatus();
   return Status::Ok();
 }
 

@@ -56,7 +56,7 @@ class Recorder {
   // if null).
   void WriteImu(const ros::Time* until);
   // Frame i and the IMU samples up to its last row, which precede it.
-  void WriteFrame(int i, double readout_s, steadiface::sim::TruthFileWriter* truth_file);
+  Status WriteFrame(int i, double readout_s, steadiface::sim::TruthFileWriter* truth_file);
 
  private:
   const SimulateOptions& o_;
@@ -87,10 +87,12 @@ void Recorder::WriteImu(const ros::Time* until) {
   }
 }
 
-void Recorder::WriteFrame(int i, double readout_s, steadiface::sim::TruthFileWriter* truth_file) {
+Status Recorder::WriteFrame(int i, double readout_s,
+                            steadiface::sim::TruthFileWriter* truth_file) {
   cv::Mat frame;
   steadiface::sim::SimTruth truth;
-  sim_.Render(i, &frame, &truth);
+  const Status rendered = sim_.Render(i, &frame, &truth);
+  if (!rendered.ok()) return rendered;
   const ros::Time stamp = ToRos(truth.stamp);
   // The camera's last row is captured at stamp + readout; IMU samples up
   // to then are recorded before the image.
@@ -123,6 +125,7 @@ void Recorder::WriteFrame(int i, double readout_s, steadiface::sim::TruthFileWri
     bag_->write(o_.info_topic, last_row, steadiface_ros::ToCameraInfo(sim_.intrinsics(), h));
   }
   truth_file->Add(i, stamp.toSec(), truth);
+  return Status::Ok();
 }
 
 // The bag (written as <out>.part, LZ4 chunks) and the truth file.
@@ -139,10 +142,13 @@ Status Record(const SimulateOptions& o, const steadiface::sim::SimulationSetting
   Recorder recorder(o, sim, &bag);
   std::ofstream csv(o.out + ".truth.csv");
   steadiface::sim::TruthFileWriter truth_file(&csv, settings);
-  for (int i = 0; i < sim.num_frames(); ++i) recorder.WriteFrame(i, so.readout_s, &truth_file);
+  Status s;
+  for (int i = 0; s.ok() && i < sim.num_frames(); ++i) {
+    s = recorder.WriteFrame(i, so.readout_s, &truth_file);
+  }
   recorder.WriteImu(nullptr);
   bag.close();
-  return Status::Ok();
+  return s;
 }
 
 }  // namespace

@@ -6,8 +6,9 @@
 namespace steadiface {
 
 /// A success flag with a human-readable message. The core never exits or
-/// aborts on bad input or options: it returns one of these instead.
-class Status {
+/// aborts on bad input or options: it returns one of these instead, and a
+/// caller that drops one gets a warning ([[nodiscard]]).
+class [[nodiscard]] Status {
  public:
   Status() = default;
   static Status Ok() { return Status(); }

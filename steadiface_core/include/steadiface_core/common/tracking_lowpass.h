@@ -17,13 +17,13 @@ class TrackingLowpass {
   explicit TrackingLowpass(double hz = 1.0) : hz_(hz) {}
 
   /// Feeds `x`, `dt` [s] after the last sample, and returns the output. The
-  /// first sample after construction or reset(), or one with dt <= 0 (or
+  /// first sample after construction or Reset(), or one with dt <= 0 (or
   /// NaN), restarts the filter at `x`.
   const Eigen::Vector2d& Update(const Eigen::Vector2d& x, double dt);
 
   const Eigen::Vector2d& value() const { return smooth_; }
   bool started() const { return started_; }
-  void reset() { started_ = false; }
+  void Reset() { started_ = false; }
 
  private:
   double hz_;
@@ -54,14 +54,14 @@ class SlowMotionFilter {
   explicit SlowMotionFilter(double hz = 1.0) : hz_(hz) {}
 
   /// Feeds `x`, `dt` [s] after the last sample, and returns the slow part.
-  /// The first sample after construction or reset(), or one with dt <= 0
+  /// The first sample after construction or Reset(), or one with dt <= 0
   /// (or NaN), restarts the filter at `x` with an unknown velocity.
   const Eigen::Vector2d& Update(const Eigen::Vector2d& x, double dt);
 
   const Eigen::Vector2d& value() const { return smooth_; }
   const Eigen::Vector2d& velocity() const { return velocity_; }
   bool started() const { return started_; }
-  void reset() { started_ = false; }
+  void Reset() { started_ = false; }
 
  private:
   double hz_;

@@ -91,8 +91,9 @@ struct EvaluationOptions {
   int average_at = -1;
 };
 
-/// Applies the overrides to one method's pipeline options.
-void ApplyViewOverrides(const ViewOverrides& view, PipelineOptions* options);
+/// Applies the overrides to one method's pipeline options; an unknown
+/// horizon mode is an error.
+Status ApplyViewOverrides(const ViewOverrides& view, PipelineOptions* options);
 
 /// Runs every preset with every method and scores each against the
 /// simulator's truth. Prints one markdown row per (preset, method) to `out`

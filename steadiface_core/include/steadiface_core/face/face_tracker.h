@@ -106,7 +106,7 @@ class FaceTracker {
                          const RowTiming* timing, FaceInfo* info);
 
   /// Drops the lock (time jumped, new epoch).
-  void reset();
+  void Reset();
 
   TrackingState state() const { return state_; }
   const FaceTrackerOptions& options() const { return options_; }

@@ -82,7 +82,7 @@ struct TimelineStats {
   uint64_t gaps = 0;
   /// Samples dropped from the front to keep the buffer bounded.
   uint64_t trimmed = 0;
-  /// reset() calls.
+  /// Reset() calls.
   uint64_t resets = 0;
 
   uint64_t count(SampleResult r) const {
@@ -142,7 +142,7 @@ class OrientationTimeline {
   /// Forgets every sample (time jumped backwards, new epoch). The next sample
   /// starts a new world frame. Counters are kept (and so is the offset
   /// correction).
-  void reset();
+  void Reset();
 
   /// A correction added to imu_time_offset_s at query time [s]: every query
   /// at camera time t reads the samples stored for t - correction, as if the

@@ -188,9 +188,9 @@ class LayerBlend {
   const std::vector<double>& vertex_blend() const { return alpha_; }
   /// Singular-value ratio of each cell of the last joined mesh [0-1].
   const std::vector<double>& cell_ratios() const { return ratios_scratch_; }
-  void reset() {
+  void Reset() {
     has_previous_ = false;
-    offset_lowpass_.reset();
+    offset_lowpass_.Reset();
   }
 
  private:

@@ -105,7 +105,7 @@ class SubjectRegionTracker {
                               const FaceObservation* face, double blend_target,
                               double dt);
   const SubjectRegion& region() const { return region_; }
-  void reset() { region_ = SubjectRegion(); }
+  void Reset() { region_ = SubjectRegion(); }
 
  private:
   // This frame's region from the landmarks, unsmoothed (invalid without a

@@ -53,7 +53,7 @@ class DynamicWeights {
                        const Eigen::Vector2d& stabilized_centre,
                        double stabilized_scale);
 
-  void reset();
+  void Reset();
   void set_options(const DynamicWeightOptions& options) { options_ = options; }
 
  private:

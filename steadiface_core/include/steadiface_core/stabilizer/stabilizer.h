@@ -189,7 +189,7 @@ class Stabilizer {
   void SetCropRatio(double r);
 
   /// Forgets the trajectory (time jumped, new epoch). Counters are kept.
-  void reset();
+  void Reset();
 
   const StabilizerOptions& options() const { return options_; }
   const StabilizerStats& stats() const { return stats_; }

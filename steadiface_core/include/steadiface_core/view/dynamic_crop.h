@@ -93,7 +93,7 @@ class DynamicCrop {
   /// (its crop ratio, needs and the target now).
   CropReport Update(double t_s, double shake_need, double solved_need);
   /// Forgets the needs and the time (a time jump); the crop stays where it is.
-  void reset();
+  void Reset();
 
  private:
   double Target(double t_s, double shake_need, double solved_need);

@@ -91,7 +91,7 @@ class GravityEstimator {
   uint64_t accepted() const { return accepted_; }
   uint64_t rejected() const { return rejected_; }
   /// Forgets the estimate (the timeline was reset: a new world frame).
-  void reset();
+  void Reset();
 
  private:
   const HorizonOptions options_;

@@ -21,7 +21,7 @@ class ShakePath {
   /// after the previous frame; the first call (or dt <= 0 after reset())
   /// starts the path there. Returns the path's rotation now.
   const Eigen::Quaterniond& Update(const Eigen::Quaterniond& R_r, double dt);
-  void reset() { started_ = false; }
+  void Reset() { started_ = false; }
 
  private:
   const double k_;  // natural frequency [rad/s]

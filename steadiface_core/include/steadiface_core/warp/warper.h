@@ -141,8 +141,8 @@ class Warper {
   /// next mesh on (OutputGeometry::WithCropRatio); the output size stays.
   void SetCropRatio(double r);
   /// Forgets the layered mesh's temporal state (time jumped).
-  void reset() {
-    if (blend_ != nullptr) blend_->reset();
+  void Reset() {
+    if (blend_ != nullptr) blend_->Reset();
   }
   /// Dense maps from the last mesh.
   void BuildMaps();
