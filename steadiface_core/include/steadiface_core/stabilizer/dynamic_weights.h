@@ -40,8 +40,8 @@ class DynamicWeights {
  public:
   explicit DynamicWeights(const DynamicWeightOptions& options);
 
-  /// `dt_s` since the previous frame (<= 0 on the first frame: factors jump
-  /// straight to their targets); `mean_angular_speed` over the window
+  /// `dt_s` since the previous frame (on the first frame, and for dt_s <= 0,
+  /// the factors jump straight to their targets); `mean_angular_speed` over the window
   /// (negative = unknown, counts as active); `face` may be null;
   /// `stabilized_centre` and `stabilized_scale` are C and the face scale as
   /// a world-fixed camera sees them (camera shake removed: each landmark
