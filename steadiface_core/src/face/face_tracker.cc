@@ -1,12 +1,15 @@
+// The face tracker's lock state machine: search, acquire, track, hold and
+// lose the face of interest (the gate: face_candidate.cc; the gyro
+// prediction: face_prediction.cc; appearance: face_appearance.cc).
 #include "steadiface_core/face/face_tracker.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
+#include "face/landmark_shape.h"
 #include "steadiface_core/camera/lens_distortion.h"
 #include "steadiface_core/common/grey.h"
 #include "steadiface_core/face/head_pose.h"
@@ -14,109 +17,8 @@
 #include "steadiface_core/face/upsampled_fit.h"
 
 namespace steadiface {
-namespace {
 
-using Clock = std::chrono::steady_clock;
-double MsSince(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-
-Eigen::Vector2d Mean(const std::vector<Eigen::Vector2d>& p) {
-  Eigen::Vector2d c = Eigen::Vector2d::Zero();
-  for (const auto& q : p) c += q;
-  return c / static_cast<double>(std::max<size_t>(1, p.size()));
-}
-
-double RmsRadius(const std::vector<Eigen::Vector2d>& p, const Eigen::Vector2d& c) {
-  double s = 0.0;
-  for (const auto& q : p) s += (q - c).squaredNorm();
-  return std::sqrt(s / std::max<size_t>(1, p.size()));
-}
-
-// Centred, unit-RMS shape.
-std::vector<Eigen::Vector2d> Normalize(const std::vector<Eigen::Vector2d>& p) {
-  const Eigen::Vector2d c = Mean(p);
-  const double s = std::max(RmsRadius(p, c), 1e-9);
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(p.size());
-  for (const auto& q : p) out.push_back((q - c) / s);
-  return out;
-}
-
-// RMS residual after the best rotation of normalized shape a onto b.
-double ProcrustesResidual(const std::vector<Eigen::Vector2d>& a,
-                          const std::vector<Eigen::Vector2d>& b) {
-  double dot = 0.0, cross = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    dot += a[i].dot(b[i]);
-    cross += a[i].x() * b[i].y() - a[i].y() * b[i].x();
-  }
-  const double th = std::atan2(cross, dot);
-  const Eigen::Rotation2Dd R(th);
-  double s = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) s += (R * a[i] - b[i]).squaredNorm();
-  return std::sqrt(s / std::max<size_t>(1, a.size()));
-}
-
-cv::Rect2d Extent(const std::vector<Eigen::Vector2d>& p) {
-  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
-  for (const auto& q : p) {
-    x0 = std::min(x0, q.x());
-    y0 = std::min(y0, q.y());
-    x1 = std::max(x1, q.x());
-    y1 = std::max(y1, q.y());
-  }
-  return cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
-}
-
-bool AllFinite(const std::vector<Eigen::Vector2d>& p) {
-  for (const auto& q : p) {
-    if (!q.allFinite()) return false;
-  }
-  return true;
-}
-
-}  // namespace
-
-Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
-  Status s = ValidateFaceDetectorOptions(o.detector);
-  if (!s.ok()) return s;
-  std::ostringstream err;
-  if (o.redetect_every_frames < 1 || o.redetect_every_frames > 10000) {
-    err << "face.redetect_every must be in [1, 10000] frames, got "
-        << o.redetect_every_frames;
-  } else if (!(o.redetect_region_scale >= 1.0 && o.redetect_region_scale <= 10.0)) {
-    err << "face.redetect_region_scale must be in [1, 10], got "
-        << o.redetect_region_scale;
-  } else if (o.redetect_face_px < 60 || o.redetect_face_px > 1000) {
-    err << "face.redetect_face_px must be in [60, 1000], got " << o.redetect_face_px;
-  } else if (o.small_face_fit_px < 0 || o.small_face_fit_px > 1000) {
-    err << "face.small_face_fit_px must be in [0, 1000], got " << o.small_face_fit_px;
-  } else if (!(o.lost_timeout_s >= 0.0 && o.lost_timeout_s <= 60.0)) {
-    err << "face.lost_timeout must be in [0, 60] s, got " << o.lost_timeout_s;
-  } else if (!(o.search_interval_s >= 0.0 && o.search_interval_s <= 10.0)) {
-    err << "face.search_interval must be in [0, 10] s, got " << o.search_interval_s;
-  } else if (!(o.max_shape_residual > 0.0 && o.max_shape_residual <= 2.0)) {
-    err << "face.max_shape_residual must be in (0, 2], got " << o.max_shape_residual;
-  } else if (!(o.min_spread_ratio > 0.0 && o.min_spread_ratio < o.max_spread_ratio &&
-               o.max_spread_ratio <= 10.0)) {
-    err << "face.min_spread_ratio/max_spread_ratio must satisfy 0 < min < max <= 10, got "
-        << o.min_spread_ratio << "/" << o.max_spread_ratio;
-  } else if (!(o.max_jump > 0.0 && o.max_jump <= 20.0)) {
-    err << "face.max_jump must be in (0, 20], got " << o.max_jump;
-  } else if (!(o.min_appearance >= -1.0 && o.min_appearance < 1.0)) {
-    err << "face.min_appearance must be in [-1, 1), got " << o.min_appearance;
-  } else if (!(o.min_region_appearance >= -1.0 && o.min_region_appearance < 1.0)) {
-    err << "face.min_region_appearance must be in [-1, 1), got " << o.min_region_appearance;
-  } else if (o.appearance_patch_px < 16 || o.appearance_patch_px > 256) {
-    err << "face.appearance_patch_px must be in [16, 256], got " << o.appearance_patch_px;
-  } else if (!(o.appearance_update_rate >= 0.0 && o.appearance_update_rate <= 1.0)) {
-    err << "face.appearance_update_rate must be in [0, 1], got "
-        << o.appearance_update_rate;
-  }
-  if (err.tellp() != 0) return Status::Error(err.str());
-  return Status::Ok();
-}
+using namespace face_internal;  // NOLINT: the tracker's own helpers
 
 Status FaceTracker::Create(const CameraModel& model,
                            const FaceTrackerOptions& options,
@@ -153,135 +55,6 @@ void FaceTracker::Reset() {
   frames_since_detect_ = 0;
   frames_tracked_ = 0;
   force_detect_ = true;
-}
-
-Eigen::Quaterniond FaceTracker::MidRotation(Time stamp,
-                                            const OrientationTimeline* tl,
-                                            const RowTiming* timing,
-                                            bool* ok) const {
-  Eigen::Quaterniond R = Eigen::Quaterniond::Identity();
-  *ok = false;
-  if (tl == nullptr || timing == nullptr) return R;
-  *ok = QuerySucceeded(tl->RealRotation(
-      timing->RowTime(stamp, 0.5 * (model_.intrinsics().height - 1)), &R));
-  return R;
-}
-
-bool FaceTracker::PredictLandmarks(Time stamp, const OrientationTimeline* tl,
-                                   const RowTiming* timing,
-                                   std::vector<Eigen::Vector2d>* predicted) const {
-  *predicted = last_landmarks_;
-  bool ok = false;
-  const Eigen::Quaterniond R_now = MidRotation(stamp, tl, timing, &ok);
-  if (!ok || !have_last_rotation_) return false;
-  // A world-fixed face seen from the rotated camera: through the world
-  // frame with the previous and the current real rotation.
-  for (auto& p : *predicted) {
-    const Eigen::Vector2d n = model_.PixelToNormalized(p);
-    Eigen::Vector2d w, m;
-    if (model_.Project(n, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(),
-                       last_rotation_, &w) &&
-        model_.Unproject(w, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(),
-                         R_now, &m)) {
-      p = model_.NormalizedToPixel(m);
-    }
-  }
-  return true;
-}
-
-cv::Rect2d FaceTracker::BoxFromLandmarks(const std::vector<Eigen::Vector2d>& lm) const {
-  const cv::Rect2d e = Extent(lm);
-  const double cx = e.x + 0.5 * e.width + box_model_[0] * e.width;
-  const double cy = e.y + 0.5 * e.height + box_model_[1] * e.height;
-  const double w = box_model_[2] * e.width, h = box_model_[3] * e.height;
-  return cv::Rect2d(cx - 0.5 * w, cy - 0.5 * h, w, h);
-}
-
-void FaceTracker::Fill(const std::vector<Eigen::Vector2d>& lm, FaceInfo* info) const {
-  info->landmarks_px = lm;
-  info->landmarks_normalized.resize(lm.size());
-  const CameraIntrinsics& k = model_.intrinsics();
-  for (size_t i = 0; i < lm.size(); ++i) {
-    Eigen::Vector2d ideal = lm[i];
-    if (k.HasDistortion()) UndistortPixel(k, lm[i], &ideal);
-    info->landmarks_normalized[i] = model_.PixelToNormalized(ideal);
-  }
-  info->centre_px = Mean(lm);
-  info->scale_px = RmsRadius(lm, info->centre_px);
-  info->centre_normalized = Mean(info->landmarks_normalized);
-  info->scale_normalized = RmsRadius(info->landmarks_normalized, info->centre_normalized);
-}
-
-bool FaceTracker::Evaluate(const cv::Mat* gray, const Candidate& c, bool acquiring,
-                           const Eigen::Vector2d* predicted_centre,
-                           FaceInfo* info, cv::Mat* patch) const {
-  const auto t0 = Clock::now();
-  FaceFailure fail = FaceFailure::kNone;
-  double score_sum = 0.0;
-  int n_scores = 0;
-  if (c.landmarks.size() != landmarks68::kCount || !AllFinite(c.landmarks)) {
-    fail = FaceFailure::kBadInput;
-  }
-  const Eigen::Vector2d centre = Mean(c.landmarks);
-  const double scale = RmsRadius(c.landmarks, centre);
-  if (fail == FaceFailure::kNone && scale < 3.0) fail = FaceFailure::kImplausibleShape;
-  // 1. Shape plausibility against the locked face (or, at acquisition,
-  // basic symmetry: eyes above the mouth, left-right ordered).
-  if (fail == FaceFailure::kNone) {
-    const auto& lm = c.landmarks;
-    namespace l68 = landmarks68;
-    const bool ordered = lm[l68::kRightEyeOuter].x() < lm[l68::kLeftEyeOuter].x() &&
-                         lm[l68::kNoseBridgeTop].y() < lm[l68::kLowerLipBottom].y() &&
-                         lm[l68::kJawRightEnd].x() < lm[l68::kJawLeftEnd].x() &&
-                         lm[l68::kMouthRight].x() < lm[l68::kMouthLeft].x();
-    info->shape_residual = acquiring || reference_shape_.empty()
-                               ? 0.0
-                               : ProcrustesResidual(Normalize(lm), reference_shape_);
-    if (!ordered || info->shape_residual > options_.max_shape_residual) {
-      fail = FaceFailure::kImplausibleShape;
-    } else {
-      score_sum += 1.0 - info->shape_residual / options_.max_shape_residual;
-      ++n_scores;
-    }
-  }
-  // 2. Spread vs the box.
-  if (fail == FaceFailure::kNone) {
-    const cv::Rect2d e = Extent(c.landmarks);
-    info->spread_ratio = std::sqrt(e.area() / std::max(1.0, c.box.area()));
-    if (info->spread_ratio < options_.min_spread_ratio ||
-        info->spread_ratio > options_.max_spread_ratio) {
-      fail = FaceFailure::kSpreadMismatch;
-    } else {
-      const double mid = 0.5 * (options_.min_spread_ratio + options_.max_spread_ratio);
-      const double half = 0.5 * (options_.max_spread_ratio - options_.min_spread_ratio);
-      score_sum += 1.0 - std::abs(info->spread_ratio - mid) / half;
-      ++n_scores;
-    }
-  }
-  // 3. Jump vs the gyro-compensated prediction (relaxed while lost: the face
-  // may have moved while it was not seen).
-  if (fail == FaceFailure::kNone && predicted_centre != nullptr && !acquiring) {
-    const double limit =
-        options_.max_jump * (state_ == TrackingState::kLost ? 3.0 : 1.0);
-    info->jump = (centre - *predicted_centre).norm() / scale;
-    if (info->jump > limit) {
-      fail = FaceFailure::kJump;
-    } else {
-      score_sum += 1.0 - info->jump / limit;
-      ++n_scores;
-    }
-  }
-  // 4. Appearance: the aligned face patch against the locked face's.
-  if (fail == FaceFailure::kNone && gray != nullptr) {
-    fail = CheckAppearance(*gray, c, acquiring, info, patch, &score_sum, &n_scores);
-  }
-  info->timings.checks_ms += MsSince(t0);
-  info->failure = fail;
-  info->confidence =
-      fail == FaceFailure::kNone
-          ? std::min(1.0, std::max(0.0, 0.5 + 0.5 * (n_scores ? score_sum / n_scores : 1.0)))
-          : 0.0;
-  return fail == FaceFailure::kNone;
 }
 
 void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,

@@ -1,0 +1,45 @@
+// The face tracker's gyro prediction: where the last landmarks move with
+// the camera's rotation between two frames (each at its own row's time).
+#include "steadiface_core/face/face_tracker.h"
+
+#include "face/landmark_shape.h"
+
+namespace steadiface {
+
+using namespace face_internal;  // NOLINT: the tracker's own helpers
+
+Eigen::Quaterniond FaceTracker::MidRotation(Time stamp,
+                                            const OrientationTimeline* tl,
+                                            const RowTiming* timing,
+                                            bool* ok) const {
+  Eigen::Quaterniond R = Eigen::Quaterniond::Identity();
+  *ok = false;
+  if (tl == nullptr || timing == nullptr) return R;
+  *ok = QuerySucceeded(tl->RealRotation(
+      timing->RowTime(stamp, 0.5 * (model_.intrinsics().height - 1)), &R));
+  return R;
+}
+
+bool FaceTracker::PredictLandmarks(Time stamp, const OrientationTimeline* tl,
+                                   const RowTiming* timing,
+                                   std::vector<Eigen::Vector2d>* predicted) const {
+  *predicted = last_landmarks_;
+  bool ok = false;
+  const Eigen::Quaterniond R_now = MidRotation(stamp, tl, timing, &ok);
+  if (!ok || !have_last_rotation_) return false;
+  // A world-fixed face seen from the rotated camera: through the world
+  // frame with the previous and the current real rotation.
+  for (auto& p : *predicted) {
+    const Eigen::Vector2d n = model_.PixelToNormalized(p);
+    Eigen::Vector2d w, m;
+    if (model_.Project(n, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(),
+                       last_rotation_, &w) &&
+        model_.Unproject(w, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(),
+                         R_now, &m)) {
+      p = model_.NormalizedToPixel(m);
+    }
+  }
+  return true;
+}
+
+}  // namespace steadiface
