@@ -23,19 +23,20 @@ Status ValidateRollingShutterOptions(const RollingShutterOptions& o) {
 RowTiming::RowTiming(const RollingShutterOptions& options, int height)
     : options_(options), height_(height < 1 ? 1 : height) {}
 
-Time RowTiming::RowTime(Time stamp, double y) const {
-  double s = 0.0;
-  switch (options_.stamp) {
+double StampShare(StampConvention stamp) {
+  switch (stamp) {
     case StampConvention::kFirstRow:
-      s = 0.0;
-      break;
+      return 0.0;
     case StampConvention::kMiddleRow:
-      s = 0.5;
-      break;
+      return 0.5;
     case StampConvention::kLastRow:
-      s = 1.0;
-      break;
+      return 1.0;
   }
+  return 0.0;
+}
+
+Time RowTiming::RowTime(Time stamp, double y) const {
+  const double s = StampShare(options_.stamp);
   const double frac = height_ > 1 ? y / (height_ - 1) : 0.0;
   const double offset_s =
       options_.readout_time_s * (frac - s) + options_.row_time_offset_s;

@@ -26,6 +26,10 @@ struct RollingShutterOptions {
 
 Status ValidateRollingShutterOptions(const RollingShutterOptions& options);
 
+/// The share of the readout from the top row to the stamped row: 0, 0.5 and
+/// 1 for first-, middle- and last-row stamps (the s of RowTiming).
+double StampShare(StampConvention stamp);
+
 /// Capture time of every image row. Row y (pixel row, 0 = top, fractional
 /// allowed) is captured at
 ///   t(y) = t_top + readout_time * y / (H - 1) + row_time_offset
