@@ -241,6 +241,18 @@ def enum_names(e):
             ["  };", "  return names;", "}"])
 
 
+def wrap(line, limit=100):
+    """A generated statement past `limit` columns, broken after its first
+    argument (or its "=") with an indented continuation."""
+    if len(line) <= limit:
+        return line
+    for sep in (", ", " = "):
+        at = line.find(sep)
+        if at > 0:
+            return line[:at + len(sep)].rstrip() + "\n      " + line[at + len(sep):]
+    return line
+
+
 def read_line(e):
     key, dest = e["key"], "&" + c_path(e["field"])
     if "enum" in e:
@@ -262,8 +274,8 @@ def section_reader(sec):
     args = ", ".join("%s%s" % (t, n if n in roots else "/*%s*/" % n) for t, n in (
         ("steadiface::PipelineOptions* ", "pipeline"), ("WrapperOptions* ", "wrapper")))
     name = "Read%s" % camel(sec["section"])
-    return name, ["// %s" % sec["section"], "void %s(Reader& r, %s) {" % (name, args)] + [
-        read_line(e) for e in entries] + ["}"]
+    return name, ["// %s" % sec["section"], "void %s(" % name,
+                  "    Reader& r, %s) {" % args] + [wrap(read_line(e)) for e in entries] + ["}"]
 
 
 def dynamic_groups(sections):
@@ -304,7 +316,7 @@ def reconfigure(sections):
         a, f = "Apply%s" % camel(g), "Config%s" % camel(g)
         out += ["void %s(const steadiface::SteadifaceConfig& c, "
                 "steadiface::PipelineOptions* pipeline) {" % a]
-        out += [apply_line(e, by_key) for e in entries] + ["}", ""]
+        out += [wrap(apply_line(e, by_key)) for e in entries] + ["}", ""]
         out += ["void %s(const steadiface::PipelineOptions& pipeline, "
                 "steadiface::SteadifaceConfig* c) {" % f]
         out += [config_line(e) for e in entries] + ["}", ""]

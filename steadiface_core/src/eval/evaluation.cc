@@ -345,8 +345,7 @@ int RunEvaluation(const EvaluationOptions& o, std::ostream& out, std::ostream& e
         return 1;
       }
       if (!s.ok()) {
-        err << preset << (s.message().compare(0, 15, "lossless input:") == 0 ? ": " : "/" + name + ": ")
-            << s.message() << "\n";
+        err << preset << "/" << name << ": " << s.message() << "\n";
         ++failures;
         continue;
       }
