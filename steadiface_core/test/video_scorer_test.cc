@@ -150,6 +150,17 @@ TEST(FfmpegBaselineTest, VidstabAndDeshakeRunAndAreScored) {
   ASSERT_TRUE(eval::VideoScorer::Create(s->intrinsics(), eval::VideoScorerOptions(), &in).ok());
   for (const cv::Mat& f : rendered) ASSERT_TRUE(in->Add(f).ok());
   const double input_bg = in->Compute().background_jitter_px;
+  // The same frames read back from the file (ScoreVideoFile, as
+  // steadiface_score_video scores a clip): every frame, the size, and the
+  // background's jitter, which the guessed camera does not change.
+  eval::VideoFileScore file;
+  ASSERT_TRUE(eval::ScoreVideoFile(input, eval::VideoScorerOptions(), &file).ok());
+  EXPECT_EQ(file.score.frames, s->num_frames());
+  EXPECT_EQ(file.width, 480);
+  EXPECT_EQ(file.height, 270);
+  EXPECT_NEAR(file.score.background_jitter_px, input_bg, 0.05 * input_bg);
+  EXPECT_FALSE(eval::ScoreVideoFile(std::string(dir) + "/missing.mkv",
+                                    eval::VideoScorerOptions(), &file).ok());
   for (auto method : {eval::FfmpegMethod::kVidstab, eval::FfmpegMethod::kDeshake}) {
     int n = 0;
     double seconds = 0.0;

@@ -38,34 +38,19 @@ int main(int argc, char** argv) {
     return status;
   }
   const std::string path = paths[0];
-  std::unique_ptr<steadiface::eval::VideoScorer> scorer;
   steadiface::eval::VideoScorerOptions o;
   o.fps = fps;
-  int w = 0, h = 0;
-  steadiface::Status s = steadiface::eval::ReadVideo(
-      path,
-      [&](const cv::Mat& f) {
-        if (!scorer) {
-          steadiface::CameraIntrinsics in;
-          in.width = f.cols;
-          in.height = f.rows;
-          in.fx = in.fy = 0.8 * f.cols;  // only sizes the face search
-          in.cx = 0.5 * f.cols;
-          in.cy = 0.5 * f.rows;
-          const steadiface::Status c = steadiface::eval::VideoScorer::Create(in, o, &scorer);
-          if (!c.ok()) return c;
-        }
-        return scorer->Add(f);
-      },
-      &w, &h);
+  steadiface::eval::VideoFileScore v;
+  const steadiface::Status s = steadiface::eval::ScoreVideoFile(path, o, &v);
   if (!s.ok()) {
     std::cerr << "steadiface_score_video: " << s.message() << "\n";
     return 1;
   }
-  const steadiface::eval::Score sc = scorer->Compute();
+  const steadiface::eval::Score& sc = v.score;
+  const int w = v.width, h = v.height;
   std::cout << "{\"name\": \"" << name << "\", \"video\": \"" << path << "\", \"size\": [" << w
             << ", " << h << "], \"frames\": " << sc.frames
-            << ", \"face_fraction\": " << Num(scorer->face_fraction())
+            << ", \"face_fraction\": " << Num(v.face_fraction)
             << ", \"head_jitter_px\": " << Num(sc.head_jitter_px)
             << ", \"head_jitter_frac\": " << Num(sc.head_jitter_frac)
             << ", \"background_jitter_px\": " << Num(sc.background_jitter_px)

@@ -8,6 +8,7 @@
 
 #include "steadiface_core/common/high_pass_rms.h"
 #include "steadiface_core/common/percentile.h"
+#include "steadiface_core/eval/ffmpeg_baseline.h"
 
 namespace steadiface {
 namespace eval {
@@ -117,6 +118,32 @@ Score VideoScorer::Compute() const {
   }
   sc.background_jitter_frac = sc.background_jitter_px / diag;
   return sc;
+}
+
+Status ScoreVideoFile(const std::string& path, const VideoScorerOptions& options,
+                      VideoFileScore* out) {
+  std::unique_ptr<VideoScorer> scorer;
+  const Status s = ReadVideo(
+      path,
+      [&](const cv::Mat& f) {
+        if (!scorer) {
+          CameraIntrinsics in;
+          in.width = f.cols;
+          in.height = f.rows;
+          in.fx = in.fy = 0.8 * f.cols;  // only sizes the face search
+          in.cx = 0.5 * f.cols;
+          in.cy = 0.5 * f.rows;
+          const Status c = VideoScorer::Create(in, options, &scorer);
+          if (!c.ok()) return c;
+        }
+        return scorer->Add(f);
+      },
+      &out->width, &out->height);
+  if (!s.ok()) return s;
+  if (!scorer) return Status::Error("no frame in '" + path + "'");
+  out->score = scorer->Compute();
+  out->face_fraction = scorer->face_fraction();
+  return Status::Ok();
 }
 
 }  // namespace eval

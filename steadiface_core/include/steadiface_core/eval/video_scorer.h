@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -69,6 +70,19 @@ class VideoScorer {
   std::vector<Eigen::Vector2d> head_;
   std::vector<Eigen::Vector2d> background_;
 };
+
+/// A video file's approximate score (steadiface_score_video).
+struct VideoFileScore {
+  Score score;
+  double face_fraction = 0.0;  ///< frames with a face found [-]
+  int width = 0, height = 0;   ///< [px]
+};
+
+/// Decodes `path` (any video ffmpeg reads) and scores every frame with a
+/// VideoScorer whose camera is a guess from the frame size (fx = 0.8 W: it
+/// only sizes the face search).
+Status ScoreVideoFile(const std::string& path, const VideoScorerOptions& options,
+                      VideoFileScore* out);
 
 }  // namespace eval
 }  // namespace steadiface
