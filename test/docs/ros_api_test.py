@@ -10,7 +10,7 @@
 - parameters: every key of the parameter table the node reads
   (steadiface_ros/src/parameter_table.inc) is a row or under a `prefix/*`
   row of "Parameters", and every row names a key or a group that exists;
-- tf: every child frame the wrapper publishes (stabilizer_wrapper.cc) is in
+- tf: every child frame the wrapper publishes (stabilizer_wrapper*.cc) is in
   "Provided tf Transforms", with the camera frame as its parent, and the
   page lists no other.
 
@@ -31,7 +31,8 @@ from junit_unittest import run_main  # noqa: E402
 
 DOC = os.path.join(REPO, "docs", "ros_api.md")
 ROS = os.path.join(REPO, "steadiface_ros", "src", "stabilizer_ros.cc")
-WRAPPER = os.path.join(REPO, "steadiface_ros", "src", "stabilizer_wrapper.cc")
+WRAPPER = [os.path.join(REPO, "steadiface_ros", "src", f)
+           for f in ("stabilizer_wrapper.cc", "stabilizer_wrapper_publish.cc")]
 TABLE = os.path.join(REPO, "steadiface_ros", "src", "parameter_table.inc")
 
 
@@ -59,7 +60,7 @@ class RosApiTest(unittest.TestCase):
     def setUpClass(cls):
         cls.doc = read(DOC)
         cls.ros = read(ROS)
-        cls.wrapper = read(WRAPPER)
+        cls.wrapper = "\n".join(read(f) for f in WRAPPER)
 
     def code_topics(self):
         subs, pubs = set(), set()
