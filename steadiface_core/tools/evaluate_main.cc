@@ -52,8 +52,11 @@ const char kUsage[] =
     "         dynamic crop between --widest R and it; default: the package's)\n"
     "       [--horizon off|level|lock] (output.horizon: the roll against the\n"
     "         accelerometer's gravity)\n"
-    "       [--rotation-source imu|visual] (visual: the camera's rotation from\n"
-    "         the video, the IMU unused)\n"
+    "       [--rotation-source auto|imu|visual] (visual: the camera's rotation\n"
+    "         from the video, the IMU unused; auto, the default: the video for\n"
+    "         the frames the gyro does not cover)\n"
+    "       [--window S,E] (also score seconds S to E on their own: the window_*\n"
+    "         figures; default: a preset's IMU dropout)\n"
     "       [--subject-reach R] (stabilizer.subject_reach, layered: H within R jaw\n"
     "         widths of where the background layer shows the face)\n"
     "       [--reach-lowpass HZ] [--reach-hold F] (stabilizer.subject_reach_lowpass,\n"
@@ -98,9 +101,15 @@ void AddPipelineFlags(CommandLine* cl, EvaluationOptions* o) {
   cl->Double("--crop", &o->crop).Double("--offset-error", &o->offset_error_s);
   cl->Double("--readout-error", &o->readout_error_s);
   cl->Double("--search-interval", &o->search_interval_s);
-  cl->Value("--rotation-source", "imu or visual", [o](const std::string& v) {
-    o->visual_rotation = v == "visual";
-    return v == "imu" || v == "visual";
+  cl->Value("--rotation-source", "auto, imu or visual", [o](const std::string& v) {
+    o->rotation_source = v == "visual" ? steadiface::RotationSource::kVisual
+                         : v == "imu"  ? steadiface::RotationSource::kImu
+                                       : steadiface::RotationSource::kAuto;
+    return v == "auto" || v == "imu" || v == "visual";
+  });
+  cl->Value("--window", "S,E (seconds)", [o](const std::string& v) {
+    return std::sscanf(v.c_str(), "%lf,%lf", &o->window_s.x(), &o->window_s.y()) == 2 &&
+           o->window_s.y() > o->window_s.x();
   });
   cl->Double("--head-w-stay", &o->head_w_stay).Double("--head-d-ref", &o->head_d_ref);
   cl->Double("--subject-reach", &o->subject_reach).Double("--reach-lowpass", &o->reach_lowpass_hz);

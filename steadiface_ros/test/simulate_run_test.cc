@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
@@ -88,6 +89,64 @@ TEST(SimulateRunTest, ARecordingReadBackIsTheSimulation) {
   EXPECT_EQ(rows, images + 1);  // a header and a row per frame
   std::remove(o.out.c_str());
   std::remove((o.out + ".truth.csv").c_str());
+  rmdir(dir.c_str());
+}
+
+// Per topic: the messages and the stamps of the IMU's [s from the epoch].
+struct Counts {
+  int images = 0, imus = 0;
+  std::vector<double> imu_t;
+};
+
+Counts Read(const std::string& path, double epoch) {
+  Counts c;
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+    if (m.instantiate<sensor_msgs::Image>()) ++c.images;
+    if (auto imu = m.instantiate<sensor_msgs::Imu>()) {
+      ++c.imus;
+      c.imu_t.push_back(imu->header.stamp.toSec() - epoch);
+    }
+  }
+  return c;
+}
+
+// A camera without an IMU (--imu-topic none), and an IMU that drops out
+// from 3 s to 5 s (the dropout preset): the frames are all there; the first
+// has no IMU message, the second none in the gap and every other one.
+TEST(SimulateRunTest, NoImuAndAnImuDropout) {
+  char tmpl[] = "/tmp/steadiface_simulate_run_test_XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const std::string dir = tmpl;
+  SimulateOptions o;
+  o.preset = "dropout";
+  o.data = STEADIFACE_TEST_DATA_DIR;
+  o.sim.width = 96;
+  o.sim.height = 54;
+  o.epoch = 100.0;
+  o.out = dir + "/dropout.bag";
+  ASSERT_EQ(RunSimulation(o), 0);
+  const Counts gap = Read(o.out, o.epoch);
+  EXPECT_EQ(gap.images, 210);  // the preset's 7 s at 30 fps
+  int in_gap = 0, before = 0, after = 0;
+  for (double t : gap.imu_t) {
+    in_gap += t > 3.001 && t < 4.999;
+    before += t < 3.0;
+    after += t > 5.0;
+  }
+  EXPECT_EQ(in_gap, 0);
+  EXPECT_NEAR(before, 600, 2);  // 200 Hz
+  EXPECT_GT(after, 400);
+  o.imu_topic = "none";
+  o.out = dir + "/no_imu.bag";
+  ASSERT_EQ(RunSimulation(o), 0);
+  const Counts none = Read(o.out, o.epoch);
+  EXPECT_EQ(none.images, 210);
+  EXPECT_EQ(none.imus, 0);
+  for (const std::string& f : {dir + "/dropout.bag", dir + "/no_imu.bag"}) {
+    std::remove(f.c_str());
+    std::remove((f + ".truth.csv").c_str());
+  }
   rmdir(dir.c_str());
 }
 

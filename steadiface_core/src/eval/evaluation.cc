@@ -104,7 +104,7 @@ Status PipelineOptionsFor(const EvaluationOptions& o, const sim::Simulator& sim,
   const Status view = ApplyViewOverrides(o.view, &po);
   if (!view.ok()) return view;
   if (std::isfinite(o.search_interval_s)) po.face.search_interval_s = o.search_interval_s;
-  if (o.visual_rotation) po.rotation_source = RotationSource::kVisual;
+  po.rotation_source = o.rotation_source;
   if (std::isfinite(o.head_w_stay)) po.stabilizer.head.w_stay = o.head_w_stay;
   if (std::isfinite(o.head_d_ref)) po.stabilizer.head.d_ref = o.head_d_ref;
   po.stabilizer.subject_reach = o.subject_reach;
@@ -229,7 +229,7 @@ Status PresetRun::RunPipeline(const std::string& name, Method m, bool video, Vid
   PipelineOptions po;
   Status s = PipelineOptionsFor(o_, *sim_, m, &po);
   std::unique_ptr<Scorecard> card;
-  if (s.ok()) s = MakeScorecard(*sim_, po, &card);
+  if (s.ok()) s = MakeScorecard(*sim_, po, &card, o_.window_s);
   if (!s.ok()) return s;
   std::unique_ptr<FrameAverager> avg;
   if (o_.average_at >= 0 && !video) {

@@ -297,6 +297,14 @@ std::string JsonDetailFields(const Score& sc) {
   num("head_max_accel_px", sc.head_max_accel_px);
   num("head_target_max_step_px", sc.head_target_max_step_px);
   num("head_target_max_accel_px", sc.head_target_max_accel_px);
+  num("rotation_error_deg", sc.rotation_error_deg);
+  num("rotation_error_px", sc.rotation_error_px);
+  num("rotation_error_max_deg", sc.rotation_error_max_deg);
+  num("window_head_jitter_px", sc.window_head_jitter_px);
+  num("window_background_jitter_px", sc.window_background_jitter_px);
+  num("window_start_step_px", sc.window_start_step_px);
+  num("window_end_step_px", sc.window_end_step_px);
+  num("virtual_step_p95_px", sc.virtual_step_p95_px);
   return o.str();
 }
 

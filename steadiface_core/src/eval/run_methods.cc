@@ -40,14 +40,22 @@ PipelineOptions OptionsFor(const sim::Simulator& sim, Method method) {
 }
 
 Status MakeScorecard(const sim::Simulator& sim, const PipelineOptions& options,
-                     std::unique_ptr<Scorecard>* card) {
+                     std::unique_ptr<Scorecard>* card, const Eigen::Vector2d& window_s) {
   CameraModel model;
   Status s = CameraModel::Create(sim.intrinsics(), options.camera, &model);
   if (!s.ok()) return s;
   OutputGeometry output;
   s = OutputGeometry::Create(model, options.warp.output, &output);
   if (!s.ok()) return s;
-  card->reset(new Scorecard(sim, model, output, ScorecardOptions()));
+  ScorecardOptions so;
+  if (window_s.allFinite()) {
+    so.window_start_s = window_s.x();
+    so.window_end_s = window_s.y();
+  } else if (ImuHasGap(sim.options())) {
+    so.window_start_s = sim.options().imu_dropout_start_s;
+    so.window_end_s = sim.options().imu_dropout_end_s;
+  }
+  card->reset(new Scorecard(sim, model, output, so));
   return Status::Ok();
 }
 
@@ -102,7 +110,10 @@ void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_off
   const auto& imu = sim.imu();
   const auto& accel = sim.accel();
   const Time need = pipeline->LastRowTime(stamp);
-  while (*next < imu.size() &&
+  // A live node waits for the gyro a little past the frame, not for ever:
+  // across an IMU dropout the frame comes first.
+  const Time latest = need + FromSeconds(kGyroWaitS);
+  while (*next < imu.size() && imu[*next].stamp + FromSeconds(imu_time_offset_s) <= latest &&
          (!pipeline->GyroCovers(stamp) ||
           imu[*next].stamp + FromSeconds(imu_time_offset_s) <= need)) {
     pipeline->AddGyro(imu[*next]);
@@ -149,8 +160,12 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
   for (int i = 0; i < sim.num_frames(); ++i) {
     const Time stamp = sim.Truth(i).stamp;
     FeedGyroForFrame(sim, stamp, o.imu.imu_time_offset_s, p.get(), &g);
+    // As the node does: in auto, a frame the gyro does not cover takes its
+    // rotation from the video.
+    if (o.rotation_source == RotationSource::kAuto) p->SetImuMissing(!p->GyroCovers(stamp));
     if (o.landmark_source == LandmarkSource::kDlib || o.render_output ||
-        o.rotation_source == RotationSource::kVisual) {
+        o.rotation_source == RotationSource::kVisual ||
+        (o.rotation_source == RotationSource::kAuto && ImuHasGap(sim.options()))) {
       s = sim.Render(i, &frame, &truth);
       if (!s.ok()) return s;
     } else {

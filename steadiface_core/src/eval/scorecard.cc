@@ -269,6 +269,7 @@ void Scorecard::Add(int index, const FrameWarp& w) {
   distortion_.push_back(CentreDistortion(w));
   undefined_ += Undefined(w, &s);
   AddStageTimes(w);
+  AddRotation(truth, w);
   samples_.push_back(s);
 }
 
@@ -465,6 +466,8 @@ Score Scorecard::Compute() const {
   ComputeBackground(fps, min_run, diag, &sc);
   ComputeMeshFigures(fps, &sc);
   ComputeCrop(pose, &sc);
+  ComputeRotationError(&sc);
+  ComputeWindow(fps, &sc);
   auto rms_deg = [](const std::vector<double>& x) {
     double s2 = 0.0;
     for (double v : x) s2 += v * v;

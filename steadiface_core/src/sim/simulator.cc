@@ -17,7 +17,8 @@ namespace sim {
 const std::vector<std::string>& PresetNames() {
   static const std::vector<std::string> names = {
       "still", "walk", "pan", "run", "occlusion", "two_faces", "turn_away", "vlog", "shake",
-      "drift", "walk_across", "bob", "hair", "passer_by", "robot", "roll"};
+      "drift", "walk_across", "bob", "hair", "passer_by", "robot", "roll",
+      "low_texture", "dropout"};
   return names;
 }
 
@@ -40,6 +41,18 @@ void StandingTremor(SimulatorOptions* o) {
   o->camera.pan_rate = 0.0;
   o->body_bob_m = o->body_sway_m = 0.0;
   o->render_torso = true;
+}
+
+// The background photo with the options' contrast and blur.
+cv::Mat Plain(const cv::Mat& photo, const SimulatorOptions& o) {
+  if (o.background_contrast == 1.0 && o.background_blur_px <= 0.0) return photo;
+  cv::Mat out;
+  const cv::Scalar mean = cv::mean(photo);
+  photo.convertTo(out, CV_32FC3);
+  out = (out - mean) * o.background_contrast + mean;
+  if (o.background_blur_px > 0.0) cv::GaussianBlur(out, out, cv::Size(), o.background_blur_px);
+  out.convertTo(out, CV_8UC3);
+  return out;
 }
 
 // The presets that differ by the camera's motion; false for another name.
@@ -80,6 +93,20 @@ bool ApplyCameraPreset(const std::string& name, SimulatorOptions* o) {
     Walking(o);
     o->camera.roll_amplitude_rad = 10.0 * M_PI / 180.0;
     o->camera.roll_hz = 0.2;
+  } else if (name == "low_texture") {
+    // A walking selfie in front of a pale, plain wall: the building at 20 %
+    // of its contrast, softened: the rotation from the video finds about a
+    // third of its usual features (sparse, not blind).
+    Walking(o);
+    o->background_contrast = 0.2;
+    o->background_blur_px = 1.0;
+  } else if (name == "dropout") {
+    // A walking selfie whose IMU drops out from 3 s to 5 s, in a sequence
+    // of at least 7 s (2 s after the IMU's return).
+    Walking(o);
+    o->duration_s = std::max(o->duration_s, 7.0);
+    o->imu_dropout_start_s = 3.0;
+    o->imu_dropout_end_s = 5.0;
   } else if (name == "robot") {
     // A legged robot's head camera (its own sensor: 640x480, 60 deg
     // horizontal field, whatever the size asked for) vibrating with the gait
@@ -228,6 +255,10 @@ Status Simulator::Create(const SimulatorOptions& options, std::unique_ptr<Simula
       !(o.real_gyro_speed > 0.0 && o.real_gyro_speed <= 10.0)) {
     return Status::Error("sim: real_gyro_scale and real_gyro_speed must be in (0, 10]");
   }
+  if (!(o.background_contrast > 0.0 && o.background_contrast <= 1.0) ||
+      !(o.background_blur_px >= 0.0 && o.background_blur_px <= 50.0)) {
+    return Status::Error("sim: background_contrast must be in (0, 1], background_blur_px in [0, 50]");
+  }
   std::unique_ptr<Simulator> s(new Simulator(options));
   Status st = s->Init();
   if (!st.ok()) return st;
@@ -244,7 +275,7 @@ Status Simulator::Init() {
     return Status::Error("sim: cannot read " + o.data_dir + "/" + o.face_photo + " or " +
                          o.background_photo);
   }
-  background_.reset(new InfiniteBackground(bg, 0.8 * intrinsics_.fx));
+  background_.reset(new InfiniteBackground(Plain(bg, o), 0.8 * intrinsics_.fx));
   const double m_per_px = o.face_width_m / o.face_width_px;
   face_ = MakeFaceBillboard(photo, o.face_region, o.face_region.width * m_per_px);
   face_centre_uv_ = o.face_centre_px - Eigen::Vector2d(o.face_region.x, o.face_region.y);
@@ -321,7 +352,10 @@ void Simulator::SynthesizeImu() {
     const double jitter = o.imu_jitter_s * n01(rng);
     const double clamp = 0.4 / o.imu_rate_hz;  // keep stamps ordered
     const double stamp = t + std::max(-clamp, std::min(clamp, jitter)) - o.imu_clock_offset_s;
-    imu_.push_back({Time(FromSeconds(stamp)), w});
+    // A dropout loses the samples, after their noise was drawn: every other
+    // sample is what it is without the dropout.
+    const bool lost = t >= o.imu_dropout_start_s && t < o.imu_dropout_end_s;
+    if (!lost) imu_.push_back({Time(FromSeconds(stamp)), w});
     // The specific force in the camera: R^T (acceleration - gravity), the
     // acceleration by central differences of the true position.
     const double h = 1e-3;
@@ -332,7 +366,7 @@ void Simulator::SynthesizeImu() {
     const Eigen::Vector3d f = P.R.conjugate() * (acc - gravity) +
                               o.accel_noise * Eigen::Vector3d(n01_accel(rng_accel), n01_accel(rng_accel),
                                                               n01_accel(rng_accel));
-    accel_.push_back({Time(FromSeconds(stamp)), f});
+    if (!lost) accel_.push_back({Time(FromSeconds(stamp)), f});
   }
 }
 

@@ -1,5 +1,6 @@
 #include "steadiface_core/sim/truth_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -98,7 +99,8 @@ Status MakeSimulatorOptions(const SimulationSettings& settings, SimulatorOptions
   const double duration = o.duration_s;
   const Status s = ApplyPreset(settings.preset, &o);
   if (!s.ok()) return s;
-  o.duration_s = duration;
+  // The given duration, or the preset's least (dropout's 7 s) if longer.
+  o.duration_s = std::max(duration, o.duration_s);
   if (settings.readout_s >= 0) o.readout_s = settings.readout_s;
   *options = o;
   return Status::Ok();

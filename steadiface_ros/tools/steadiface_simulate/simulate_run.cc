@@ -67,6 +67,7 @@ class Recorder {
 };
 
 void Recorder::WriteImu(const ros::Time* until) {
+  if (o_.imu_topic == "none") return;  // a camera without an IMU
   const auto& imu = sim_.imu();
   for (; g_ < imu.size() && (!until || ToRos(imu[g_].stamp) <= *until); ++g_) {
     sensor_msgs::Imu m;
@@ -177,8 +178,13 @@ int RunSimulation(const SimulateOptions& o) {
     return 1;
   }
   std::cout << "wrote " << o.out << " (" << sim->num_frames() << " frames " << k.width << "x"
-            << k.height << (o.mono ? " mono8" : " bgr8") << ", " << sim->imu().size()
-            << " IMU samples at " << so.imu_rate_hz << " Hz) and " << o.out << ".truth.csv\n";
+            << k.height << (o.mono ? " mono8" : " bgr8") << ", ";
+  if (o.imu_topic == "none") {
+    std::cout << "no IMU";
+  } else {
+    std::cout << sim->imu().size() << " IMU samples at " << so.imu_rate_hz << " Hz";
+  }
+  std::cout << ") and " << o.out << ".truth.csv\n";
   return 0;
 }
 

@@ -22,7 +22,7 @@ struct SimulateOptions {
   double readout = -1;   ///< the rolling-shutter readout [s]; < 0: the preset's
   std::string image_topic = "/camera/image_raw";
   std::string info_topic = "/camera/camera_info";  ///< "none": no camera_info
-  std::string imu_topic = "/imu";
+  std::string imu_topic = "/imu";  ///< "none": no IMU (a camera without one)
   std::string camera_frame = "camera_optical", imu_frame = "camera_optical";
   /// Also the intrinsics as a camera_calibration YAML (empty: none).
   std::string calibration_out;
@@ -34,7 +34,8 @@ struct SimulateOptions {
 
 /// Renders the preset into a bag (images, camera_info, IMU with angular
 /// velocity, linear acceleration and orientation_covariance[0] = -1, in
-/// time order as a recording would be) and its ground truth beside it.
+/// time order as a recording would be; a preset's IMU dropout leaves a gap)
+/// and its ground truth beside it.
 /// Messages go to stderr, the summary line to stdout. Returns the
 /// process's exit status: 0 written, 1 a failure.
 int RunSimulation(const SimulateOptions& options);

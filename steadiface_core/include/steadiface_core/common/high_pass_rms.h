@@ -14,4 +14,9 @@ namespace steadiface {
 double HighPassRms(const std::vector<Eigen::Vector2d>& x, double fps,
                    double cutoff_hz);
 
+/// What HighPassRms takes the RMS of: the high-passed trajectory, per
+/// sample (x's size; zeros for fewer than 4 samples).
+std::vector<Eigen::Vector2d> HighPass(const std::vector<Eigen::Vector2d>& x,
+                                      double fps, double cutoff_hz);
+
 }  // namespace steadiface

@@ -66,8 +66,11 @@ struct EvaluationOptions {
   double crop = NAN;
   /// face.search_interval [s].
   double search_interval_s = NAN;
-  /// rotation_source visual (the IMU unused).
-  bool visual_rotation = false;
+  /// rotation_source: auto (the package's default), imu or visual.
+  RotationSource rotation_source = RotationSource::kAuto;
+  /// A window of each sequence scored on its own (start, end) [s]; NaN: the
+  /// simulated IMU's dropout, if any.
+  Eigen::Vector2d window_s = Eigen::Vector2d::Constant(NAN);
   /// head.w_stay [-] and head.d_ref [fraction of the width].
   double head_w_stay = NAN, head_d_ref = NAN;
   /// stabilizer.subject_reach [jaw widths] (0: off), its low-pass [Hz] and hold.

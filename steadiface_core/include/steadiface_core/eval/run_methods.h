@@ -32,22 +32,34 @@ const char* MethodName(Method m);
 PipelineOptions OptionsFor(const sim::Simulator& sim, Method method);
 
 /// The scorecard for warps a pipeline with `options` produces on `sim` (its
-/// camera model and output geometry), with default scorecard options.
+/// camera model and output geometry), with default scorecard options; its
+/// window is `window_s` (start, end) when finite, else the simulated IMU's
+/// dropout, if any.
 Status MakeScorecard(const sim::Simulator& sim, const PipelineOptions& options,
-                     std::unique_ptr<Scorecard>* card);
+                     std::unique_ptr<Scorecard>* card,
+                     const Eigen::Vector2d& window_s = Eigen::Vector2d::Constant(NAN));
 
-/// Feeds the simulator's gyro samples from index `*next` on into `pipeline`
-/// until they cover the frame stamped `stamp` up to just past its last row,
-/// as a live node would have them (`imu_time_offset_s` as in the pipeline's
-/// options); advances `*next`.
 /// The warp `pipeline` applied to the frame it just processed (`out`), for
 /// the scorecard: the pose, or in layered mode the joined mesh and the
 /// background layer's, read from the pipeline's warper (so ask before the
 /// next frame). `rendered`: the output was rendered (adds the warp's time).
 FrameWarp MakeFrameWarp(const PipelineFrame& out, const Pipeline& pipeline, bool rendered);
 
+/// How long past a frame's last row the gyro is waited for [s].
+constexpr double kGyroWaitS = 0.1;
+
+/// Feeds the simulator's gyro samples from index `*next` on into `pipeline`
+/// until they cover the frame stamped `stamp` up to just past its last row,
+/// as a live node would have them (`imu_time_offset_s` as in the pipeline's
+/// options), but none stamped more than kGyroWaitS after that row: across
+/// an IMU dropout the frame is left uncovered. Advances `*next`.
 void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_offset_s,
                       Pipeline* pipeline, size_t* next);
+
+/// True when the simulated IMU drops out (SimulatorOptions::imu_dropout_*).
+inline bool ImuHasGap(const sim::SimulatorOptions& o) {
+  return o.imu_dropout_start_s >= 0.0 && o.imu_dropout_end_s > o.imu_dropout_start_s;
+}
 
 /// Renders every frame, feeds the IMU and the frames through a Pipeline
 /// (render_output off unless `render`), and scores the warps. Fills

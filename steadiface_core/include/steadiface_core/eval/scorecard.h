@@ -134,6 +134,24 @@ struct Score {
   /// offsets from the background layer, in output px, mean over vertices
   /// in the band on >= half of the frames (NaN without such vertices).
   double band_jitter_px = NAN;
+  /// The rotation the stabilizer used against the truth (kPose, kComposite,
+  /// kMesh with its rows): the RMS over consecutive frames of the error of
+  /// the camera's frame-to-frame rotation at the middle row [deg], the same
+  /// at the input's focal length [input px], and the largest [deg]. NaN for
+  /// other warps.
+  double rotation_error_deg = NAN, rotation_error_px = NAN;
+  double rotation_error_max_deg = NAN;
+  /// Within ScorecardOptions' window (an IMU dropout): the head's and the
+  /// visible background's jitter on the window's frames (each trajectory
+  /// high-passed whole, its RMS taken over the window) [output px]. The
+  /// virtual pose's largest per-frame step (kMesh: the scene layer's)
+  /// within edge_s after each edge of the window (the hand-overs), and the
+  /// 95th percentile of its steps on the other frames, at the output's
+  /// focal length [output px]. NaN without a window (and for warps with no
+  /// virtual pose).
+  double window_head_jitter_px = NAN, window_background_jitter_px = NAN;
+  double window_start_step_px = NAN, window_end_step_px = NAN;
+  double virtual_step_p95_px = NAN;
   /// Per-stage time, median and p99 [ms].
   std::vector<std::pair<std::string, std::pair<double, double>>> stage_ms;
 };
@@ -141,6 +159,11 @@ struct Score {
 struct ScorecardOptions {
   /// High-pass cut-off for jitter [Hz].
   double highpass_hz = 0.5;
+  /// A window of the sequence scored on its own [s from the start]; NaN:
+  /// none (Score::window_*).
+  double window_start_s = NAN, window_end_s = NAN;
+  /// How long after each edge of the window a hand-over is looked for [s].
+  double edge_s = 0.5;
 };
 
 /// Evaluates any stabilizer's per-frame warps against a simulated
@@ -189,6 +212,8 @@ class Scorecard {
   double CentreDistortion(const FrameWarp& w) const;
   bool Undefined(const FrameWarp& w, Sample* s) const;
   void AddStageTimes(const FrameWarp& w);
+  // The true and the used middle-row rotation, and the virtual pose.
+  void AddRotation(const sim::SimTruth& truth, const FrameWarp& w);
   // The output's and the input's roll against the true gravity.
   void AddRoll(const sim::SimTruth& truth, const FrameWarp& w);
   // Compute's pieces: the background figures (trajectories scored on runs
@@ -197,6 +222,9 @@ class Scorecard {
   void ComputeMeshFigures(double fps, Score* sc) const;
   // The crop kept: mean and least width, its steps and second difference.
   void ComputeCrop(bool pose, Score* sc) const;
+  // The rotation's error against the truth, and the window's figures.
+  void ComputeRotationError(Score* sc) const;
+  void ComputeWindow(double fps, Score* sc) const;
   bool MapToOutput(const FrameWarp& w, const Eigen::Vector2d& in_px,
                    Eigen::Vector2d* out_px) const;
   // kComposite: whether the subject, placed by the subject layer, covers
@@ -236,6 +264,9 @@ class Scorecard {
   int undefined_ = 0;
   bool identity_ = true;
   std::vector<std::pair<std::string, std::vector<double>>> stages_;
+  // Per frame (kPose, kComposite, kMesh; empty otherwise): the true and the
+  // used world -> camera rotation at the middle row, and R_v (kMesh: R_b).
+  std::vector<Eigen::Quaterniond> true_middle_, used_middle_, virtual_;
 };
 
 }  // namespace eval

@@ -43,6 +43,11 @@ struct SimulatorOptions {
   std::string data_dir;
   std::string face_photo = "astronaut.png";
   std::string background_photo = "building.jpg";
+  /// The background photo's contrast about its mean [-] and a Gaussian blur
+  /// of it [px, sigma]: 1 and 0 show it as it is; a small contrast and a
+  /// blur make a plain, low-texture wall.
+  double background_contrast = 1.0;
+  double background_blur_px = 0.0;
   /// Head region cropped from the face photo onto the billboard, the
   /// landmark centre inside the photo and the face width there [px]
   /// (defaults: astronaut.png, from dlib's 68 landmarks).
@@ -98,6 +103,9 @@ struct SimulatorOptions {
   /// gravity along the world's +y, "down", and the camera's acceleration).
   double accel_noise = 0.03;
   double imu_clock_offset_s = 0.0;
+  /// The IMU drops out: no gyro or accelerometer sample between these
+  /// times [s] (a cable or driver fault); negative = never.
+  double imu_dropout_start_s = -1, imu_dropout_end_s = -1;
   /// Events (times in seconds from the start; negative = never).
   double occlusion_start_s = -1, occlusion_end_s = -1;
   double face_out_start_s = -1, face_out_end_s = -1;
@@ -117,7 +125,10 @@ struct SimulatorOptions {
 /// +-100 px at 720p, with neck and shoulders: what the composite is judged
 /// on), hair (vlog with hair strands at the head's top edge), passer_by
 /// (walk with neck and shoulders, a person walking across behind), roll
-/// (walk under a slow +-10 deg roll: what the level horizon is judged on).
+/// (walk under a slow +-10 deg roll: what the level horizon is judged on),
+/// low_texture (walk in front of a pale wall: 20 % of the building's
+/// contrast, softened), dropout (walk, at least 7 s long, whose IMU drops out
+/// from 3 s to 5 s): the last two judge the rotation from the video.
 Status ApplyPreset(const std::string& name, SimulatorOptions* options);
 const std::vector<std::string>& PresetNames();
 

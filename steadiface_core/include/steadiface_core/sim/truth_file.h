@@ -31,7 +31,8 @@ struct SimulationSettings {
   double epoch_s = 0.0;
 };
 
-/// The preset with the settings on top, as steadiface_simulate applies them.
+/// The preset with the settings on top, as steadiface_simulate applies them
+/// (a preset that needs a longer sequence, dropout, keeps its length).
 Status MakeSimulatorOptions(const SimulationSettings& settings, SimulatorOptions* options);
 
 /// One frame of a truth file: the simulator's truth at the recorded stamp.
