@@ -129,7 +129,31 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
 SampleResult Pipeline::AddGyro(const GyroSample& sample) {
   // kVisual: the video gives the rotation.
   if (options_.rotation_source == RotationSource::kVisual) return SampleResult::kAccepted;
+  if (video_newest_) {
+    // kAuto after frames from the video: held back until the video reaches
+    // it (HandBackToGyro), at most a few seconds of samples.
+    if (!sample.angular_velocity.allFinite()) return timeline_.AddSample(sample);  // counted
+    if (pending_gyro_.size() >= kMaxPendingGyro) pending_gyro_.pop_front();
+    pending_gyro_.push_back(sample);
+    return SampleResult::kAccepted;
+  }
   return timeline_.AddSample(sample);
+}
+
+void Pipeline::HandBackToGyro() {
+  // The samples the video's nodes already passed are not needed.
+  while (!pending_gyro_.empty() &&
+         timeline_.CameraTime(pending_gyro_.front().stamp) <= timeline_.newest()) {
+    pending_gyro_.pop_front();
+  }
+  if (pending_gyro_.size() < 2) return;
+  const Duration spacing = pending_gyro_[1].stamp - pending_gyro_[0].stamp;
+  if (timeline_.CameraTime(pending_gyro_.front().stamp) - timeline_.newest() > spacing * 3 / 2) {
+    return;  // the video has not reached the gyro yet
+  }
+  video_newest_ = false;
+  for (const GyroSample& g : pending_gyro_) timeline_.AddSample(g);
+  pending_gyro_.clear();
 }
 
 bool Pipeline::AddAccel(const AccelSample& sample) {
@@ -163,6 +187,10 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     Status v = f.rotation_from_video ? VisualStep(grey, stamp, &f)
                                      : visual_->Remember(grey, stamp);
     if (!v.ok()) return v;
+    if (options_.rotation_source == RotationSource::kAuto && f.rotation_from_video) {
+      video_newest_ = true;
+      HandBackToGyro();
+    }
     visual_mid_ = timing_.RowTime(stamp, 0.5 * (k.height - 1));
     has_visual_mid_ = true;
   }
@@ -498,7 +526,7 @@ Status Pipeline::VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f) {
   }
   if (last_row <= timeline_.newest()) return Status::Ok();  // the gyro covers it after all
   // The rotation between the two frames' middle rows and across this
-  // frame's rows is the pair's (omega + alpha (t - stamp)), from the
+  // frame's rows is the pair's (its omega(t) integrated), from the
   // orientation at the previous frame's middle row: nodes every 2 ms from
   // the newest (the previous frame's last row, or the gyro's newest sample)
   // to this frame's last row. Rows already used keep the rotations they
@@ -516,16 +544,15 @@ Status Pipeline::VisualStep(const cv::Mat& grey, Time stamp, PipelineFrame* f) {
   for (int k = 1; k <= steps; ++k) {
     const Time t = from + (last_row - from) * k / steps;
     const double u = ToSeconds(t - f->visual.stamp);
-    const Eigen::Vector3d phi =
-        f->visual.omega * (u - ta) + 0.5 * f->visual.alpha * (u * u - ta * ta);
-    const Eigen::Vector3d omega = f->visual.omega + f->visual.alpha * u;
-    timeline_.AddOrientation(t, anchor * ExpSO3(phi), omega);
+    timeline_.AddOrientation(t, anchor * ExpSO3(f->visual.Turn(ta, u)), f->visual.RateAt(u));
   }
   return Status::Ok();
 }
 
 void Pipeline::Reset() {
   timeline_.Reset();
+  video_newest_ = false;
+  pending_gyro_.clear();
   if (visual_ != nullptr) visual_->Reset();
   has_visual_mid_ = false;
   if (tracker_ != nullptr) tracker_->Reset();

@@ -14,7 +14,7 @@ namespace {
 
 // The scene point's bearing in the second frame, Exp(-phi) b1.
 Eigen::Vector3d Moved(const Motion& m, const BearingPair& p) {
-  return ExpSO3(-(p.c * m.head<3>() + p.d * m.tail<3>())) * p.b1;
+  return ExpSO3(-(p.c * m.head<3>() + p.d * m.segment<3>(3) + p.e * m.tail<3>())) * p.b1;
 }
 
 double ErrorPx(const Motion& omega, const BearingPair& p, double focal_px) {
@@ -32,15 +32,15 @@ std::vector<int> Inliers(const std::vector<BearingPair>& pairs,
   return in;
 }
 
-// Gauss-Newton on the pairs `in` (6 unknowns), damped a little so that a
+// Gauss-Newton on the pairs `in` (9 unknowns), damped a little so that a
 // triple's nearly singular system stays bounded. The Jacobian takes the
 // rotation as small (b2 + b2 x dphi for a change dphi): one frame's turn
 // is a few degrees, and the residuals themselves are exact.
 Motion Refine(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
-              Motion m, int iterations, double alpha_weight) {
+              Motion m, int iterations, const MotionPrior& prior) {
   for (int iter = 0; iter < iterations; ++iter) {
-    Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> Jtr = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix<double, 9, 9> JtJ = Eigen::Matrix<double, 9, 9>::Zero();
+    Eigen::Matrix<double, 9, 1> Jtr = Eigen::Matrix<double, 9, 1>::Zero();
     for (int i : in) {
       const BearingPair& p = pairs[i];
       const Eigen::Vector3d b2 = Moved(m, p);
@@ -51,14 +51,16 @@ Motion Refine(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
       Eigen::Matrix3d skew;  // d b2 / d phi, with b2 = Exp(-phi) b1
       skew << 0.0, -b2.z(), b2.y(), b2.z(), 0.0, -b2.x(), -b2.y(), b2.x(), 0.0;
       const Eigen::Matrix<double, 2, 3> Jphi = Jp * skew;
-      Eigen::Matrix<double, 2, 6> J;
-      J << p.c * Jphi, p.d * Jphi;
+      Eigen::Matrix<double, 2, 9> J;
+      J << p.c * Jphi, p.d * Jphi, p.e * Jphi;
       JtJ += J.transpose() * J;
       Jtr += J.transpose() * r;
     }
-    // The prior on alpha: alpha_weight |alpha|^2.
-    JtJ.diagonal().tail<3>().array() += alpha_weight;
-    Jtr.tail<3>() += alpha_weight * m.tail<3>();
+    // The priors: alpha |alpha|^2 + beta |beta|^2.
+    JtJ.diagonal().segment<3>(3).array() += prior.alpha;
+    Jtr.segment<3>(3) += prior.alpha * m.segment<3>(3);
+    JtJ.diagonal().tail<3>().array() += prior.beta;
+    Jtr.tail<3>() += prior.beta * m.tail<3>();
     JtJ.diagonal() *= 1.0 + 1e-9;
     JtJ.diagonal().array() += 1e-12;
     const Motion delta = JtJ.ldlt().solve(-Jtr);
@@ -76,45 +78,76 @@ Eigen::Vector2d Predict(const Motion& m, const BearingPair& p) {
   return b2.head<2>() / b2.z();
 }
 
-bool FitMotion(const std::vector<BearingPair>& pairs, double focal_px,
-               double threshold_px, int iterations, double alpha_weight,
-               uint64_t seed, RotationFit* fit) {
-  const int n = static_cast<int>(pairs.size());
-  if (n < 3) return false;
-  std::mt19937_64 rng(seed);
+namespace {
+
+// RANSAC over triples of the pairs `pool` (indices): the hypothesis whose
+// inliers among `pool` have the most summed weight. Adaptive: it stops once
+// a hypothesis with the best's share of inliers would have been drawn with
+// 99 % probability, after at least kMinIterations.
+struct Hypothesis {
+  Motion motion = Motion::Zero();
+  std::vector<int> inliers;
+  double support = 0.0;
+};
+
+Hypothesis Ransac(const std::vector<BearingPair>& pairs, const std::vector<int>& pool,
+                  const std::vector<double>& weights, double focal_px, double threshold_px,
+                  int iterations, const MotionPrior& prior, std::mt19937_64* rng) {
+  Hypothesis best;
+  const int n = static_cast<int>(pool.size());
+  if (n < 3) return best;
+  std::vector<BearingPair> sub;
+  for (int i : pool) sub.push_back(pairs[i]);
   std::uniform_int_distribution<int> pick(0, n - 1);
-  std::vector<int> best;
-  Motion best_m = Motion::Zero();
-  // Adaptive: stop once a hypothesis with this share of inliers would have
-  // been drawn with 99 % probability, after at least kMinIterations.
   constexpr int kMinIterations = 24;
   int needed = iterations;
   for (int it = 0; it < needed; ++it) {
-    const int a = pick(rng);
-    const int b = (a + 1 + pick(rng) % (n - 1)) % n;
-    int c = pick(rng);
+    const int a = pick(*rng);
+    const int b = (a + 1 + pick(*rng) % (n - 1)) % n;
+    int c = pick(*rng);
     if (c == a || c == b) continue;
-    const Motion m = Refine(pairs, {a, b, c}, Motion::Zero(), 3, alpha_weight);
+    const Motion m = Refine(sub, {a, b, c}, Motion::Zero(), 3, prior);
     if (!m.allFinite()) continue;
-    std::vector<int> in = Inliers(pairs, m, focal_px, threshold_px);
-    if (in.size() > best.size()) {
-      best.swap(in);
-      best_m = m;
-      const double w = static_cast<double>(best.size()) / n;
-      const double miss = 1.0 - w * w * w;
-      if (miss < 1e-9) {
-        needed = std::min(needed, std::max(it + 1, kMinIterations));
-      } else {
-        needed = std::min(
-            needed,
-            std::max(kMinIterations, static_cast<int>(std::ceil(
-                                         std::log(0.01) / std::log(miss)))));
-      }
+    std::vector<int> in = Inliers(sub, m, focal_px, threshold_px);
+    double w = 0.0;
+    for (int& i : in) {
+      i = pool[i];
+      w += weights.empty() ? 1.0 : weights[i];
     }
+    if (w <= best.support) continue;
+    best = {m, std::move(in), w};
+    const double share = static_cast<double>(best.inliers.size()) / n;
+    const double miss = 1.0 - share * share * share;
+    needed = std::min(needed, miss < 1e-9 ? std::max(it + 1, kMinIterations)
+                                          : std::max(kMinIterations,
+                                                     static_cast<int>(std::ceil(
+                                                         std::log(0.01) / std::log(miss)))));
   }
+  return best;
+}
+
+}  // namespace
+
+bool FitMotion(const std::vector<BearingPair>& pairs, const std::vector<double>& weights,
+               double focal_px, double threshold_px, int iterations, const MotionPrior& prior,
+               uint64_t seed, RotationFit* fit) {
+  const int n = static_cast<int>(pairs.size());
+  if (n < 3) return false;
+  auto support = [&weights](const std::vector<int>& in) {
+    double w = 0.0;
+    for (int i : in) w += weights.empty() ? 1.0 : weights[i];
+    return w;
+  };
+  std::vector<int> all(n);
+  for (int i = 0; i < n; ++i) all[i] = i;
+  const double total = support(all);
+  std::mt19937_64 rng(seed);
+  Hypothesis h = Ransac(pairs, all, weights, focal_px, threshold_px, iterations, prior, &rng);
+  std::vector<int> best = h.inliers;
+  Motion best_m = h.motion;
   if (best.size() < 3) return false;
   for (int round = 0; round < 2; ++round) {
-    best_m = Refine(pairs, best, best_m, 5, alpha_weight);
+    best_m = Refine(pairs, best, best_m, 5, prior);
     best = Inliers(pairs, best_m, focal_px, threshold_px);
     if (best.size() < 3) return false;
   }
@@ -123,6 +156,7 @@ bool FitMotion(const std::vector<BearingPair>& pairs, double focal_px,
   fit->motion = best_m;
   fit->inliers = best;
   fit->rms_px = std::sqrt(ss / best.size());
+  fit->support = support(best) / total;
   return true;
 }
 

@@ -43,9 +43,10 @@ Status ValidateVisualRotationOptions(const VisualRotationOptions& o) {
     err << "visual.min_inlier_ratio must be in [0, 1], got "
         << o.min_inlier_ratio;
   } else if (!(o.feature_noise_px > 0.0 && o.feature_noise_px <= 20.0) ||
-             !(o.alpha_prior_rad_s2 > 0.0 && o.alpha_prior_rad_s2 <= 1e4)) {
-    err << "visual.feature_noise_px must be in (0, 20] and alpha_prior_rad_s2 "
-           "in (0, 1e4]";
+             !(o.alpha_prior_rad_s2 > 0.0 && o.alpha_prior_rad_s2 <= 1e4) ||
+             !(o.beta_prior_rad_s3 > 0.0 && o.beta_prior_rad_s3 <= 1e6)) {
+    err << "visual.feature_noise_px must be in (0, 20], alpha_prior_rad_s2 "
+           "in (0, 1e4] and beta_prior_rad_s3 in (0, 1e6]";
   } else if (!(o.face_margin >= 0.0 && o.face_margin <= 10.0) ||
              !(o.body_width >= 0.0 && o.body_width <= 20.0)) {
     err << "visual.face_margin must be in [0, 10] and body_width in [0, 20]";
@@ -82,6 +83,7 @@ VisualRotationEstimator::VisualRotationEstimator(
 void VisualRotationEstimator::Reset() {
   prev_.release();
   prev_points_.clear();
+  prev_age_.clear();
 }
 
 cv::Mat VisualRotationEstimator::SubjectMask(const cv::Size& size,
@@ -122,6 +124,7 @@ void VisualRotationEstimator::Refill(const cv::Mat& small,
   cv::goodFeaturesToTrack(small, fresh, want, 0.01, options_.min_distance_px,
                           free, 5);
   prev_points_.insert(prev_points_.end(), fresh.begin(), fresh.end());
+  prev_age_.resize(prev_points_.size(), 0);
 }
 
 namespace {
@@ -152,6 +155,8 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
       0, options_.min_texture);
   std::vector<visual::BearingPair> pairs;
   std::vector<cv::Point2f> kept;
+  std::vector<int> kept_age;
+  std::vector<double> weights;
   const cv::Rect2f inside(0.f, 0.f, small.cols - 1.f, small.rows - 1.f);
   for (size_t i = 0; i < next.size(); ++i) {
     if (!status[i] || !inside.contains(next[i]) ||
@@ -168,35 +173,48 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
     const double t2 = ToSeconds(timing_.RowTime(stamp, y2) - out->stamp);
     p.c = t2 - t1;
     p.d = 0.5 * (t2 * t2 - t1 * t1);
+    p.e = (t2 * t2 * t2 - t1 * t1 * t1) / 6.0;
     pairs.push_back(p);
     kept.push_back(next[i]);
+    kept_age.push_back(prev_age_[i]);
+    // A feature that has moved with the scene for a few frames outvotes a
+    // fresh one: the scene it lies on has shown itself to be the scene.
+    weights.push_back(1.0 + std::min(prev_age_[i], kMatureAge));
   }
   out->tracked = static_cast<int>(pairs.size());
   visual::RotationFit fit;
   const double focal_px = model_.real_focal() * model_.intrinsics().width;
   const double sigma_n = options_.feature_noise_px / focal_px;
-  const double alpha_weight =
-      sigma_n * sigma_n /
-      (options_.alpha_prior_rad_s2 * options_.alpha_prior_rad_s2);
-  if (visual::FitMotion(pairs, focal_px, options_.inlier_threshold_px,
-                        options_.ransac_iterations, alpha_weight,
+  visual::MotionPrior prior;
+  prior.alpha = sigma_n * sigma_n / (options_.alpha_prior_rad_s2 * options_.alpha_prior_rad_s2);
+  prior.beta = sigma_n * sigma_n / (options_.beta_prior_rad_s3 * options_.beta_prior_rad_s3);
+  if (visual::FitMotion(pairs, weights, focal_px, options_.inlier_threshold_px,
+                        options_.ransac_iterations, prior,
                         static_cast<uint64_t>(ToNanoseconds(stamp)), &fit)) {
     out->inliers = static_cast<int>(fit.inliers.size());
     out->residual_px = fit.rms_px;
-    out->valid = out->inliers >= options_.min_inliers &&
-                 out->inliers >= options_.min_inlier_ratio * out->tracked;
+    out->support = fit.support;
+    out->valid = out->inliers >= options_.min_inliers && fit.support >= options_.min_inlier_ratio;
     if (out->valid) {
       out->omega = fit.motion.head<3>();
-      out->alpha = fit.motion.tail<3>();
+      out->alpha = fit.motion.segment<3>(3);
+      out->beta = fit.motion.tail<3>();
+      // Keep tracking the features that moved with the camera, one frame
+      // older: a passer-by's are dropped, and fresh ones are found where
+      // the scene is. (Not trusted: every track is kept as it was.)
+      std::vector<cv::Point2f> in;
+      std::vector<int> in_age;
+      in.reserve(fit.inliers.size());
+      for (int i : fit.inliers) {
+        in.push_back(kept[i]);
+        in_age.push_back(kept_age[i] + 1);
+      }
+      kept.swap(in);
+      kept_age.swap(in_age);
     }
-    // Keep tracking the features that moved with the camera: a passer-by's
-    // are dropped, and fresh ones are found where the scene is.
-    std::vector<cv::Point2f> in;
-    in.reserve(fit.inliers.size());
-    for (int i : fit.inliers) in.push_back(kept[i]);
-    kept.swap(in);
   }
   prev_points_.swap(kept);
+  prev_age_.swap(kept_age);
 }
 
 Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
@@ -255,6 +273,7 @@ Status VisualRotationEstimator::Remember(const cv::Mat& gray, Time stamp) {
   prev_ = Copy(gray);
   prev_stamp_ = stamp;
   prev_points_.clear();
+  prev_age_.clear();
   return Status::Ok();
 }
 

@@ -159,6 +159,9 @@ class OrientationTimeline {
   /// correction included).
   Time oldest() const { return samples_.front().t + correction_; }
   Time newest() const { return samples_.back().t + correction_; }
+  /// The camera-clock time a gyro sample stamped `imu_stamp` would be
+  /// stored at (the offset and its correction applied).
+  Time CameraTime(Time imu_stamp) const { return imu_stamp + time_offset_ + correction_; }
   /// Whether a query at t would succeed without extrapolation.
   bool Covers(Time t) const {
     return !samples_.empty() && t - correction_ >= samples_.front().t &&

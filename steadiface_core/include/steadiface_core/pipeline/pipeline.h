@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -285,6 +286,15 @@ class Pipeline {
   Time visual_mid_;                                  // the last frame's middle row
   bool has_visual_mid_ = false;
   bool imu_missing_ = false;  // kAuto: SetImuMissing
+  // kAuto: the timeline's newest nodes came from the video, and the gyro
+  // samples that arrived since, held back until the video has reached them
+  // (a hand-back never bridges the gap by integrating across it).
+  bool video_newest_ = false;
+  std::deque<GyroSample> pending_gyro_;
+  static constexpr size_t kMaxPendingGyro = 4096;  // 20 s at 200 Hz
+  // Hands the held-back gyro samples to the timeline once the video's
+  // newest node is within a sample's spacing of them; drops those it passed.
+  void HandBackToGyro();
   std::unique_ptr<SubjectRegionTracker> region_;  // layered and composite mode
   std::unique_ptr<Compositor> compositor_;       // composite mode
   std::unique_ptr<DynamicCrop> crop_;

@@ -33,14 +33,22 @@ struct VisualRotationOptions {
   double inlier_threshold_px = 2.0;
   /// RANSAC hypotheses (three features each) per frame, at most [count].
   int ransac_iterations = 64;
-  /// A tracked feature's position error [px] and the typical rate of change
-  /// of a hand's angular velocity [rad/s^2] (0.5 rad/s at 6 Hz): together
-  /// the prior that keeps the within-frame change from fitting the noise.
+  /// A tracked feature's position error [px], and how fast a hand's angular
+  /// velocity changes [rad/s^2] and how fast that changes [rad/s^3]: weak
+  /// priors that keep the motion within the pair from fitting the noise.
+  /// Over the two frames' 50 ms a shake's angular velocity bends, so both
+  /// are fitted. The priors are about twice what a brisk handheld walk
+  /// shows: the recorded phone walk (test/data/gyro) has 10 rad/s^2 and
+  /// 700 rad/s^3 RMS (22 and 1600 at the 95th percentile), the simulator's
+  /// walk (0.7 deg RMS shake up to 12 Hz) about 28 and 1600 RMS.
   double feature_noise_px = 1.0;
-  double alpha_prior_rad_s2 = 20.0;
+  double alpha_prior_rad_s2 = 60.0;
+  double beta_prior_rad_s3 = 1000.0;
   /// A rotation is trusted with at least this many inliers [count] ...
   int min_inliers = 20;
-  /// ... making up at least this fraction of the tracked features [-].
+  /// ... making up at least this fraction of the tracked features [-],
+  /// each feature weighted by how long it has moved with the scene (1 when
+  /// fresh, up to 5 after four frames).
   double min_inlier_ratio = 0.5;
   /// The subject is left out: the face box grown by this fraction of its
   /// width on each side and above [-], and below it a column this many
@@ -65,8 +73,21 @@ struct VisualRotation {
   /// omega(t) = omega + alpha (t - stamp) from the previous frame's first
   /// row to this one's last (0 when invalid).
   Eigen::Vector3d alpha = Eigen::Vector3d::Zero();
+  /// Its second derivative [rad/s^3]: omega(t) = omega + alpha u +
+  /// beta u^2 / 2, u = t - stamp (0 when invalid).
+  Eigen::Vector3d beta = Eigen::Vector3d::Zero();
+  /// The camera's turn from u0 to u1 seconds after `stamp` (the integral
+  /// of omega(t), as a rotation vector in the camera) [rad].
+  Eigen::Vector3d Turn(double u0, double u1) const {
+    return omega * (u1 - u0) + alpha * (u1 * u1 - u0 * u0) / 2.0 +
+           beta * (u1 * u1 * u1 - u0 * u0 * u0) / 6.0;
+  }
+  /// The angular velocity u seconds after `stamp` [rad/s].
+  Eigen::Vector3d RateAt(double u) const { return omega + alpha * u + beta * u * u / 2.0; }
   int tracked = 0;  ///< feature pairs outside the subject [count]
   int inliers = 0;  ///< pairs that fit the rotation [count]
+  /// The inliers' share of the pairs, each weighted by its age [-].
+  double support = 0.0;
   /// RMS reprojection error of the inliers [px].
   double residual_px = 0.0;
   double ms = 0.0;  ///< wall time of Process [ms]
@@ -121,6 +142,9 @@ class VisualRotationEstimator {
   cv::Mat prev_;        // the previous copy
   Time prev_stamp_;
   std::vector<cv::Point2f> prev_points_;  // in the copy
+  // Per feature: the frames it has moved with the scene for [count].
+  std::vector<int> prev_age_;
+  static constexpr int kMatureAge = 4;  // weight 1 + min(age, 4)
 };
 
 }  // namespace steadiface
