@@ -82,6 +82,7 @@ VisualRotationEstimator::VisualRotationEstimator(
 
 void VisualRotationEstimator::Reset() {
   prev_.release();
+  prev_pyramid_.clear();
   prev_points_.clear();
   prev_age_.clear();
 }
@@ -147,8 +148,15 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
   std::vector<unsigned char> status;
   std::vector<float> error;
   const int w = options_.klt_window_px;
+  // The pyramids (with their derivatives) are built once per frame: this
+  // frame's is the next one's previous.
+  if (prev_pyramid_.empty()) {
+    cv::buildOpticalFlowPyramid(prev_, prev_pyramid_, cv::Size(w, w), options_.klt_levels);
+  }
+  std::vector<cv::Mat> pyramid;
+  cv::buildOpticalFlowPyramid(small, pyramid, cv::Size(w, w), options_.klt_levels);
   cv::calcOpticalFlowPyrLK(
-      prev_, small, prev_points_, next, status, error, cv::Size(w, w),
+      prev_pyramid_, pyramid, prev_points_, next, status, error, cv::Size(w, w),
       options_.klt_levels,
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30,
                        0.01),
@@ -215,6 +223,7 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
   }
   prev_points_.swap(kept);
   prev_age_.swap(kept_age);
+  prev_pyramid_.swap(pyramid);
 }
 
 Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
@@ -232,12 +241,15 @@ Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
   const cv::Mat mask = SubjectMask(small.size(), face);
   // After Remember() the previous frame has a picture but no features yet.
   if (!prev_.empty() && prev_points_.empty()) Refill(prev_, mask);
-  if (!prev_.empty() && !prev_points_.empty()) {
+  const bool track = !prev_.empty() && !prev_points_.empty();
+  if (track) {
     const double mid = 0.5 * (k.height - 1);
     out->stamp =
         timing_.RowTime(prev_stamp_, mid) +
         (timing_.RowTime(stamp, mid) - timing_.RowTime(prev_stamp_, mid)) / 2;
-    Track(small, mask, stamp, out);
+    Track(small, mask, stamp, out);  // leaves this frame's pyramid
+  } else {
+    prev_pyramid_.clear();
   }
   Refill(small, mask);
   prev_ = small;
@@ -271,6 +283,7 @@ Status VisualRotationEstimator::Remember(const cv::Mat& gray, Time stamp) {
   Status s = CheckGray(gray);
   if (!s.ok()) return s;
   prev_ = Copy(gray);
+  prev_pyramid_.clear();
   prev_stamp_ = stamp;
   prev_points_.clear();
   prev_age_.clear();

@@ -140,6 +140,7 @@ class VisualRotationEstimator {
   const VisualRotationOptions options_;
   double scale_ = 1.0;  // copy / full resolution
   cv::Mat prev_;        // the previous copy
+  std::vector<cv::Mat> prev_pyramid_;  // its KLT pyramid (empty: not built yet)
   Time prev_stamp_;
   std::vector<cv::Point2f> prev_points_;  // in the copy
   // Per feature: the frames it has moved with the scene for [count].
