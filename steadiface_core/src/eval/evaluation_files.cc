@@ -283,6 +283,7 @@ std::string JsonDetailFields(const Score& sc) {
   std::ostringstream o;
   auto num = [&o](const char* name, double v) { o << ", \"" << name << "\": " << JsonNumber(v); };
   num("visible_background_jitter_px", sc.visible_background_jitter_px);
+  num("visible_background_max_step_px", sc.visible_background_max_step_px);
   num("line_deviation_px", sc.line_deviation_px);
   o << ", \"line_deviation_frame\": " << sc.line_deviation_frame;
   num("min_cell_ratio", sc.min_cell_ratio);

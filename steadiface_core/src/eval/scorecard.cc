@@ -467,6 +467,7 @@ Score Scorecard::Compute() const {
   ComputeMeshFigures(fps, &sc);
   ComputeCrop(pose, &sc);
   ComputeRotationError(&sc);
+  ComputeBackgroundSteps(&sc);
   ComputeWindow(fps, &sc);
   auto rms_deg = [](const std::vector<double>& x) {
     double s2 = 0.0;

@@ -1,6 +1,6 @@
 // The scorecard's rotation figures: the rotation the stabilizer used
-// against the truth, and a window of the sequence (an IMU dropout) scored
-// on its own with its hand-overs.
+// against the truth, the visible background's largest jump, and a window
+// of the sequence (an IMU dropout) scored on its own with its hand-overs.
 #include <algorithm>
 #include <cmath>
 
@@ -71,6 +71,22 @@ void Scorecard::ComputeRotationError(Score* sc) const {
   sc->rotation_error_deg = rms * 180.0 / M_PI;
   sc->rotation_error_max_deg = worst * 180.0 / M_PI;
   sc->rotation_error_px = rms * model_.real_focal() * model_.intrinsics().width;
+}
+
+void Scorecard::ComputeBackgroundSteps(Score* sc) const {
+  double worst = NAN;
+  for (size_t i = 1; i < samples_.size(); ++i) {
+    std::vector<double> steps;
+    for (const auto& traj : visible_out_) {
+      if (i < traj.size() && traj[i].allFinite() && traj[i - 1].allFinite()) {
+        steps.push_back((traj[i] - traj[i - 1]).norm());
+      }
+    }
+    if (steps.empty()) continue;
+    const double median = Percentile(steps, 0.5);
+    if (!(worst >= median)) worst = median;
+  }
+  sc->visible_background_max_step_px = worst;
 }
 
 void Scorecard::ComputeWindow(double fps, Score* sc) const {

@@ -106,6 +106,10 @@ struct Score {
   /// torso) covers it, mean over the points [output px]. The fair
   /// background figure for a warp that treats the subject differently.
   double visible_background_jitter_px = NAN;
+  /// The visible background's largest jump: per frame, the median over
+  /// the points visible on it and the frame before of their step in the
+  /// output; the largest over frames [output px]. NaN without such points.
+  double visible_background_max_step_px = NAN;
   /// Straightness of straight background lines (world great circles) in
   /// the output, where visible: the largest distance of a line's points
   /// from their fitted line over all lines and frames [output px], and the
@@ -224,6 +228,7 @@ class Scorecard {
   void ComputeCrop(bool pose, Score* sc) const;
   // The rotation's error against the truth, and the window's figures.
   void ComputeRotationError(Score* sc) const;
+  void ComputeBackgroundSteps(Score* sc) const;
   void ComputeWindow(double fps, Score* sc) const;
   bool MapToOutput(const FrameWarp& w, const Eigen::Vector2d& in_px,
                    Eigen::Vector2d* out_px) const;
