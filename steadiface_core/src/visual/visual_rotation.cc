@@ -190,40 +190,47 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
     weights.push_back(1.0 + std::min(prev_age_[i], kMatureAge));
   }
   out->tracked = static_cast<int>(pairs.size());
+  Fit(pairs, weights, stamp, out, &kept, &kept_age);
+  prev_points_.swap(kept);
+  prev_age_.swap(kept_age);
+  prev_pyramid_.swap(pyramid);
+}
+
+void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
+                                  const std::vector<double>& weights, Time stamp,
+                                  VisualRotation* out, std::vector<cv::Point2f>* kept,
+                                  std::vector<int>* kept_age) const {
   visual::RotationFit fit;
   const double focal_px = model_.real_focal() * model_.intrinsics().width;
   const double sigma_n = options_.feature_noise_px / focal_px;
   visual::MotionPrior prior;
   prior.alpha = sigma_n * sigma_n / (options_.alpha_prior_rad_s2 * options_.alpha_prior_rad_s2);
   prior.beta = sigma_n * sigma_n / (options_.beta_prior_rad_s3 * options_.beta_prior_rad_s3);
-  if (visual::FitMotion(pairs, weights, focal_px, options_.inlier_threshold_px,
-                        options_.ransac_iterations, prior,
-                        static_cast<uint64_t>(ToNanoseconds(stamp)), &fit)) {
-    out->inliers = static_cast<int>(fit.inliers.size());
-    out->residual_px = fit.rms_px;
-    out->support = fit.support;
-    out->valid = out->inliers >= options_.min_inliers && fit.support >= options_.min_inlier_ratio;
-    if (out->valid) {
-      out->omega = fit.motion.head<3>();
-      out->alpha = fit.motion.segment<3>(3);
-      out->beta = fit.motion.tail<3>();
-      // Keep tracking the features that moved with the camera, one frame
-      // older: a passer-by's are dropped, and fresh ones are found where
-      // the scene is. (Not trusted: every track is kept as it was.)
-      std::vector<cv::Point2f> in;
-      std::vector<int> in_age;
-      in.reserve(fit.inliers.size());
-      for (int i : fit.inliers) {
-        in.push_back(kept[i]);
-        in_age.push_back(kept_age[i] + 1);
-      }
-      kept.swap(in);
-      kept_age.swap(in_age);
-    }
+  if (!visual::FitMotion(pairs, weights, focal_px, options_.inlier_threshold_px,
+                         options_.ransac_iterations, prior,
+                         static_cast<uint64_t>(ToNanoseconds(stamp)), &fit)) {
+    return;
   }
-  prev_points_.swap(kept);
-  prev_age_.swap(kept_age);
-  prev_pyramid_.swap(pyramid);
+  out->inliers = static_cast<int>(fit.inliers.size());
+  out->residual_px = fit.rms_px;
+  out->support = fit.support;
+  out->valid = out->inliers >= options_.min_inliers && fit.support >= options_.min_inlier_ratio;
+  if (!out->valid) return;  // not trusted: every track is kept as it was
+  out->omega = fit.motion.head<3>();
+  out->alpha = fit.motion.segment<3>(3);
+  out->beta = fit.motion.tail<3>();
+  // Keep tracking the features that moved with the camera, one frame
+  // older: a passer-by's are dropped, and fresh ones are found where the
+  // scene is.
+  std::vector<cv::Point2f> in;
+  std::vector<int> in_age;
+  in.reserve(fit.inliers.size());
+  for (int i : fit.inliers) {
+    in.push_back((*kept)[i]);
+    in_age.push_back((*kept_age)[i] + 1);
+  }
+  kept->swap(in);
+  kept_age->swap(in_age);
 }
 
 Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,

@@ -12,6 +12,9 @@
 #include "steadiface_core/common/time.h"
 
 namespace steadiface {
+namespace visual {
+struct BearingPair;
+}  // namespace visual
 
 struct VisualRotationOptions {
   /// Features are tracked on a grey copy at most this long [px].
@@ -131,6 +134,12 @@ class VisualRotationEstimator {
   // fitted, the features that fit kept.
   void Track(const cv::Mat& small, const cv::Mat& mask, Time stamp,
              VisualRotation* out);
+  // The rotation fitted to the tracked pairs (into *out); when trusted,
+  // the tracks `kept` (with their ages) narrowed to its inliers, a frame
+  // older.
+  void Fit(const std::vector<visual::BearingPair>& pairs, const std::vector<double>& weights,
+           Time stamp, VisualRotation* out, std::vector<cv::Point2f>* kept,
+           std::vector<int>* kept_age) const;
   cv::Mat SubjectMask(const cv::Size& size, const cv::Rect2d& face) const;
   cv::Mat Copy(const cv::Mat& gray) const;  // the tracking copy of a frame
   Status CheckGray(const cv::Mat& gray) const;  // 8-bit grey, the camera's size
