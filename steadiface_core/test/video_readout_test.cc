@@ -46,7 +46,7 @@ VideoReadoutResult EstimateOn(const std::string& preset, double readout_s, doubl
   return r;
 }
 
-// Waved by hand at 2-4 Hz, 4 s (measured: 10.3, 20.7, 30.9 ms).
+// Waved by hand at 2-4 Hz, 4 s (measured: 10.7, 20.4, 29.7 ms).
 TEST(VideoReadoutTest, TheReadoutOfAWavedCameraFromTheVideoAlone) {
   for (double readout : {0.01, 0.02, 0.03}) {
     const VideoReadoutResult r = EstimateOn("walk", readout, 4.0, true);
@@ -56,8 +56,8 @@ TEST(VideoReadoutTest, TheReadoutOfAWavedCameraFromTheVideoAlone) {
 }
 
 // The walking selfie's shake (0.7 deg RMS up to 12 Hz): the low-passed part
-// is smaller against the noise (measured: 10.6 and 19.6 ms; at 30 ms not
-// determined, correlation 0.46). Determined or not, never far off.
+// is smaller against the noise (measured: 10.3 and 20.6 ms; at 30 ms not
+// determined, correlation 0.35). Determined or not, never far off.
 TEST(VideoReadoutTest, AWalkingSelfieDeterminesItOrSaysItCannot) {
   for (double readout : {0.01, 0.02, 0.03}) {
     const VideoReadoutResult r = EstimateOn("walk", readout, 4.0);

@@ -1,7 +1,7 @@
 // RunCalibration (steadiface_calibrate's run) on the simulated walk whose
 // IMU stamps are 30 ms early: the overlay it writes recovers the offset and
-// the identity mounting, and a recording it cannot use is refused with
-// nothing written.
+// the identity mounting; without an IMU, the readout from the video; and a
+// recording it cannot use is refused with nothing written.
 #include "steadiface_calibrate/calibrate_run.h"
 
 #include <sys/stat.h>
@@ -51,7 +51,23 @@ TEST_F(CalibrateRunTest, RecoversTheClockOffsetOfARecording) {
   EXPECT_EQ(stat(o_.report.c_str(), &st), 0);
 }
 
-TEST_F(CalibrateRunTest, ARecordingWithoutImuIsRefusedAndNothingWritten) {
+// Without IMU messages the readout comes from the video alone: a 4 s
+// walking selfie at 640x360 read out in 25 ms (measured: 25.2 +- 1.4 ms).
+TEST_F(CalibrateRunTest, WithoutAnImuTheReadoutComesFromTheVideo) {
+  o_.in = std::string(STEADIFACE_TEST_BAG_DIR) + "/check_noimu.bag";
+  ASSERT_EQ(RunCalibration(o_), 0);
+  const YAML::Node y = YAML::LoadFile(o_.out);
+  EXPECT_NEAR(y["camera"]["readout_time"].as<double>(), 0.025, 0.003);
+  EXPECT_FALSE(y["imu"]);
+  struct stat st;
+  EXPECT_EQ(stat(o_.report.c_str(), &st), 0);
+}
+
+// The 8 s walk at 480x270 without its IMU does not determine the readout
+// from the video (its shake is mostly above what the frame rate follows;
+// measured correlation 0.16): refused, and a missing bag too; nothing
+// written either time.
+TEST_F(CalibrateRunTest, ARecordingItCannotUseIsRefusedAndNothingWritten) {
   o_.in = std::string(STEADIFACE_TEST_BAG_DIR) + "/check_offset.bag";
   o_.topics.imu = "/nothing";
   EXPECT_EQ(RunCalibration(o_), 1);

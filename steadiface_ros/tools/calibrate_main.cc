@@ -31,6 +31,8 @@ const char kUsage[] =
     "camera/stamp, camera/readout_time, imu/time_offset (the search is "
     "+-0.5 s\n"
     "around it) and camera_info_url when the bag has no camera_info.\n"
+    "Without IMU messages (a camera without an IMU): camera/readout_time alone,\n"
+    "from the video; wave the camera gently by hand (1-4 Hz) for a few seconds.\n"
     "Exit 0 with the overlay written; 1 when the recording cannot "
     "determine the\n"
     "result (the reason is printed; nothing is written); 2 on usage "

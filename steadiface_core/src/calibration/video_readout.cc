@@ -12,11 +12,11 @@ namespace {
 constexpr double kSigma = 2.5;  // the low-pass's Gaussian [pairs]
 
 // The fit's priors for calibration: the within-frame rate of change left
-// free (it is what is measured), its curvature held at 0.
+// free (it is what is measured), its curvature as in the pipeline.
 VisualRotationOptions CalibrationVisualOptions() {
   VisualRotationOptions o;
   o.alpha_prior_rad_s2 = 1e4;
-  o.beta_prior_rad_s3 = 1e-3;
+  o.beta_prior_rad_s3 = 1000.0;
   return o;
 }
 

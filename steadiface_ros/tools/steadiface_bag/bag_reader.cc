@@ -97,13 +97,15 @@ std::vector<std::string> BagReader::WithAndWithoutSlash(
   return v;
 }
 
-size_t BagReader::ImageCount() const {
-  if (fast_) return fast_->Count(WithAndWithoutSlash(topics_.image));
+size_t BagReader::Count(const std::string& topic) const {
+  if (fast_) return fast_->Count(WithAndWithoutSlash(topic));
   if (!bag_) return 0;
-  return rosbag::View(*bag_,
-                      rosbag::TopicQuery(WithAndWithoutSlash(topics_.image)))
-      .size();
+  return rosbag::View(*bag_, rosbag::TopicQuery(WithAndWithoutSlash(topic))).size();
 }
+
+size_t BagReader::ImageCount() const { return Count(topics_.image); }
+
+size_t BagReader::ImuCount() const { return Count(topics_.imu); }
 
 template <typename As>
 bool BagReader::Dispatch(const std::string& raw_topic, const ros::Time& time, As as,

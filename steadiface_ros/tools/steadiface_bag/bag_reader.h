@@ -74,8 +74,9 @@ class BagReader {
   /// Compressed images that did not decode, and (indexed reader) messages
   /// that did not deserialize; each skipped (read after Join).
   size_t decode_failures() const { return decode_failures_; }
-  /// Number of messages on the image topic.
+  /// Number of messages on the image topic, and on the IMU topic.
   size_t ImageCount() const;
+  size_t ImuCount() const;
   /// Starts the reader thread; it closes `queue` at the end or on error.
   void Start(BoundedQueue<BagItem>* queue);
   /// Waits for the reader thread; returns its error ("" if none).
@@ -89,6 +90,7 @@ class BagReader {
 
  private:
   std::vector<std::string> WithAndWithoutSlash(const std::string& t) const;
+  size_t Count(const std::string& topic) const;  // messages on `topic`
   // The reader thread's work: every message of the topics, in bag order,
   // through the indexed reader or rosbag::View.
   void ReadAll(BoundedQueue<BagItem>* queue);

@@ -12,6 +12,7 @@
 
 #include "steadiface_bag/bounded_queue.h"
 #include "steadiface_core/calibration/calibrator.h"
+#include "steadiface_core/calibration/video_readout.h"
 #include "steadiface_ros/camera_info_source.h"
 #include "steadiface_ros/msg_conversion.h"
 #include "steadiface_ros/params.h"
@@ -270,9 +271,121 @@ Status Calibrate(const CalibrateOptions& o, steadiface::CalibrationResult* r, si
   return st.ok() ? st : Status::Error(st.message() + "\nnothing written.");
 }
 
+// Without an IMU: the readout from the video alone, fed frame by frame.
+Status FeedVideo(const steadiface::PipelineOptions& po,
+                 steadiface_ros::CameraInfoSource* info_source,
+                 steadiface_bag::BoundedQueue<steadiface_bag::BagItem>* queue,
+                 std::unique_ptr<steadiface::VideoReadoutEstimator>* est) {
+  steadiface_bag::BagItem item;
+  sensor_msgs::CameraInfoConstPtr last_info;
+  while (queue->Pop(&item)) {
+    if (item.info) last_info = item.info;
+    if (!item.image) continue;
+    const sensor_msgs::CameraInfoConstPtr info = info_source->Select(*item.image, last_info);
+    cv::Mat image, grey;
+    if (!info || !steadiface_ros::ToCvImage(*item.image, &image).ok()) continue;
+    if (!*est) {
+      steadiface::CameraIntrinsics k;
+      Status st = steadiface_ros::ToCameraIntrinsics(*info, &k);
+      if (st.ok()) st = steadiface::VideoReadoutEstimator::Create(k, po.shutter, {}, est);
+      if (!st.ok()) return st;
+    }
+    if (image.channels() == 1) {
+      grey = image;
+    } else {
+      cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+    }
+    const Status st = (*est)->AddFrame(grey, steadiface_ros::ToCoreTime(item.image->header.stamp));
+    if (!st.ok()) return st;
+  }
+  return Status::Ok();
+}
+
+Status CalibrateFromVideo(const CalibrateOptions& o, steadiface::VideoReadoutResult* r,
+                          int* frames) {
+  steadiface::PipelineOptions po;
+  steadiface_ros::WrapperOptions wo;
+  Status st = steadiface_ros::LoadPackageOptions(o.params, &po, &wo);
+  if (!st.ok()) return st;
+  steadiface_ros::CameraInfoSource info_source([](bool, const std::string& text) {
+    std::cerr << "steadiface_calibrate: " << text << "\n";
+  });
+  st = info_source.Load(wo.camera_info_url);
+  steadiface_bag::BagReader reader(o.in, o.topics);
+  if (st.ok()) st = reader.Open(/*info_required=*/!info_source.has_file_info());
+  if (!st.ok()) return st;
+  steadiface_bag::BoundedQueue<steadiface_bag::BagItem> queue(64);
+  reader.Start(&queue);
+  std::unique_ptr<steadiface::VideoReadoutEstimator> est;
+  st = FeedVideo(po, &info_source, &queue, &est);
+  if (!st.ok()) queue.Close();
+  const std::string reader_error = reader.Join();
+  if (!st.ok()) return st;
+  if (!reader_error.empty()) return Status::Error(reader_error);
+  if (!est) return Status::Error("no usable image in '" + o.in + "'");
+  *r = est->Estimate();
+  *frames = est->frames();
+  if (!r->determined) {
+    std::ostringstream why;
+    why << "the readout is not determined from the video: " << r->reason << " ("
+        << *frames << " frames, " << r->triples << " frame triples, correlation "
+        << r->correlation << ", estimate " << r->readout_s * 1e3 << " +- " << r->sigma_s * 1e3
+        << " ms); nothing written.";
+    return Status::Error(why.str());
+  }
+  return Status::Ok();
+}
+
+// The overlay without an IMU: the readout alone.
+Status WriteVideoOverlay(const steadiface::VideoReadoutResult& r, const std::string& in,
+                         int frames, const std::string& out) {
+  std::ofstream y(out + ".part");
+  y << std::setprecision(9) << "# steadiface_calibrate --in " << in << " (no IMU in it)\n"
+    << "# " << frames << " frames; the readout from the video alone: " << r.triples
+    << " frame triples, correlation " << r.correlation << ", shake " << r.shake_hz << " Hz.\n"
+    << "camera:\n  readout_time: " << r.readout_s << "  # [s] +-" << r.sigma_s * 1e3 << " ms\n";
+  y.close();
+  if (!y || std::rename((out + ".part").c_str(), out.c_str()) != 0) {
+    return Status::Error("cannot write '" + out + "'");
+  }
+  return Status::Ok();
+}
+
+// A recording without IMU messages: the readout from the video alone.
+int RunVideoCalibration(const CalibrateOptions& o) {
+  steadiface::VideoReadoutResult r;
+  int frames = 0;
+  Status st = CalibrateFromVideo(o, &r, &frames);
+  if (st.ok()) st = WriteVideoOverlay(r, o.in, frames, o.out);
+  if (!st.ok()) {
+    std::cerr << "steadiface_calibrate: " << st.message() << "\n";
+    return 1;
+  }
+  if (!o.report.empty()) {
+    std::ofstream j(o.report);
+    j << std::setprecision(9) << "{\n  \"in\": \"" << o.in << "\",\n  \"frames\": " << frames
+      << ",\n  \"imu_samples\": 0,\n  \"readout_s\": " << r.readout_s
+      << ",\n  \"readout_sigma_s\": " << r.sigma_s << ",\n  \"readout_determined\": true"
+      << ",\n  \"triples\": " << r.triples << ",\n  \"correlation\": " << r.correlation
+      << ",\n  \"shake_hz\": " << r.shake_hz << "\n}\n";
+  }
+  std::cout << "steadiface_calibrate: no IMU in the recording; readout " << r.readout_s * 1e3
+            << " ms (+-" << r.sigma_s * 1e3 << ") from the video alone; wrote " << o.out << "\n";
+  return 0;
+}
+
+// Whether the recording has IMU messages (an unreadable bag: true, so that
+// the IMU calibration reports why).
+bool HasImu(const CalibrateOptions& o) {
+  steadiface_bag::BagReader reader(o.in, o.topics);
+  if (!reader.Open(/*info_required=*/false).ok()) return true;
+  return reader.ImuCount() > 0;
+}
+
 }  // namespace
 
 int RunCalibration(const CalibrateOptions& o) {
+  if (!HasImu(o)) return RunVideoCalibration(o);
   steadiface::CalibrationResult r;
   size_t frames = 0, imu = 0;
   Status st = Calibrate(o, &r, &frames, &imu);

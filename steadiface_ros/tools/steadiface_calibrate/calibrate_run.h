@@ -28,7 +28,9 @@ struct CalibrateOptions {
 /// (--params) load as is; with `report` and `plot` also those. Messages go
 /// to stderr, the summary line to stdout. Returns the process's exit status:
 /// 0 with the overlay written, 1 when the recording cannot determine the
-/// result (the reason is printed; nothing is written).
+/// result (the reason is printed; nothing is written). A recording without
+/// IMU messages gives the rolling-shutter readout from the video alone
+/// (steadiface::VideoReadoutEstimator), written as camera/readout_time.
 int RunCalibration(const CalibrateOptions& options);
 
 }  // namespace steadiface_calibrate
