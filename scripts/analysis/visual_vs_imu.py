@@ -19,7 +19,22 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from scipy.spatial.transform import Rotation  # noqa: E402
+
+
+def exp_so3(v):
+    """Rodrigues: a rotation vector to its matrix."""
+    a = np.linalg.norm(v)
+    k = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    if a < 1e-12:
+        return np.eye(3) + k
+    return np.eye(3) + np.sin(a) / a * k + (1 - np.cos(a)) / a ** 2 * k @ k
+
+
+def log_so3(m):
+    """A rotation matrix (less than 180 deg) to its rotation vector."""
+    a = np.arccos(np.clip((np.trace(m) - 1) / 2, -1, 1))
+    w = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]]) / 2
+    return w if a < 1e-9 else w * a / np.sin(a)
 
 
 def turns(path):
@@ -27,9 +42,9 @@ def turns(path):
     with open(path) as f:
         rows = list(csv.DictReader(f))
     t = np.array([float(r["t"]) for r in rows])
-    r = Rotation.from_rotvec([[float(x["real_r" + k]) for k in "xyz"] for x in rows])
+    r = [exp_so3(np.array([float(x["real_r" + k]) for k in "xyz"])) for x in rows]
     # R_r maps world to camera: the turn in the camera is R_i R_{i-1}^T.
-    d = (r[1:] * r[:-1].inv()).as_rotvec()
+    d = np.array([log_so3(b @ a.T) for a, b in zip(r, r[1:])])
     return t[1:], np.degrees(d)
 
 
