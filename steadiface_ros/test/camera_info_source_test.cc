@@ -247,6 +247,15 @@ TEST(ExampleOverlaysTest, LayeredSwitchesOnlyTheWarpMode) {
                                        l.po.warp));
 }
 
+TEST(ExampleOverlaysTest, NoImuTakesTheRotationFromTheVideoAndChangesNothingElse) {
+  const Loaded n = LoadExample("no_imu.yaml");
+  const Loaded d = LoadExample("../default.yaml");
+  EXPECT_EQ(n.po.rotation_source, steadiface::RotationSource::kVisual);
+  EXPECT_EQ(d.po.rotation_source, steadiface::RotationSource::kAuto);
+  EXPECT_EQ(n.po.warp.mode, d.po.warp.mode);
+  EXPECT_EQ(n.po.shutter.readout_time_s, d.po.shutter.readout_time_s);
+}
+
 TEST(ExampleOverlaysTest, CompositeSwitchesOnlyTheWarpMode) {
   const Loaded c = LoadExample("composite.yaml");
   const Loaded d = LoadExample("../default.yaml");
