@@ -80,24 +80,21 @@ Eigen::Vector2d Predict(const Motion& m, const BearingPair& p) {
 
 namespace {
 
-// RANSAC over triples of the pairs `pool` (indices): the hypothesis whose
-// inliers among `pool` have the most summed weight. Adaptive: it stops once
-// a hypothesis with the best's share of inliers would have been drawn with
-// 99 % probability, after at least kMinIterations.
+// RANSAC over triples of the pairs: the hypothesis whose inliers have the
+// most summed weight. Adaptive: it stops once a hypothesis with the best's
+// share of inliers would have been drawn with 99 % probability, after at
+// least kMinIterations.
 struct Hypothesis {
   Motion motion = Motion::Zero();
   std::vector<int> inliers;
   double support = 0.0;
 };
 
-Hypothesis Ransac(const std::vector<BearingPair>& pairs, const std::vector<int>& pool,
-                  const std::vector<double>& weights, double focal_px, double threshold_px,
-                  int iterations, const MotionPrior& prior, std::mt19937_64* rng) {
+Hypothesis Ransac(const std::vector<BearingPair>& pairs, const std::vector<double>& weights,
+                  double focal_px, double threshold_px, int iterations, const MotionPrior& prior,
+                  std::mt19937_64* rng) {
   Hypothesis best;
-  const int n = static_cast<int>(pool.size());
-  if (n < 3) return best;
-  std::vector<BearingPair> sub;
-  for (int i : pool) sub.push_back(pairs[i]);
+  const int n = static_cast<int>(pairs.size());
   std::uniform_int_distribution<int> pick(0, n - 1);
   constexpr int kMinIterations = 24;
   int needed = iterations;
@@ -106,14 +103,11 @@ Hypothesis Ransac(const std::vector<BearingPair>& pairs, const std::vector<int>&
     const int b = (a + 1 + pick(*rng) % (n - 1)) % n;
     int c = pick(*rng);
     if (c == a || c == b) continue;
-    const Motion m = Refine(sub, {a, b, c}, Motion::Zero(), 3, prior);
+    const Motion m = Refine(pairs, {a, b, c}, Motion::Zero(), 3, prior);
     if (!m.allFinite()) continue;
-    std::vector<int> in = Inliers(sub, m, focal_px, threshold_px);
+    std::vector<int> in = Inliers(pairs, m, focal_px, threshold_px);
     double w = 0.0;
-    for (int& i : in) {
-      i = pool[i];
-      w += weights.empty() ? 1.0 : weights[i];
-    }
+    for (int i : in) w += weights.empty() ? 1.0 : weights[i];
     if (w <= best.support) continue;
     best = {m, std::move(in), w};
     const double share = static_cast<double>(best.inliers.size()) / n;
@@ -142,7 +136,7 @@ bool FitMotion(const std::vector<BearingPair>& pairs, const std::vector<double>&
   for (int i = 0; i < n; ++i) all[i] = i;
   const double total = support(all);
   std::mt19937_64 rng(seed);
-  Hypothesis h = Ransac(pairs, all, weights, focal_px, threshold_px, iterations, prior, &rng);
+  Hypothesis h = Ransac(pairs, weights, focal_px, threshold_px, iterations, prior, &rng);
   std::vector<int> best = h.inliers;
   Motion best_m = h.motion;
   if (best.size() < 3) return false;
