@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -22,6 +23,7 @@ namespace steadiface_calibrate {
 namespace {
 
 using steadiface::Status;
+using Queue = steadiface_bag::BoundedQueue<steadiface_bag::BagItem>;
 
 // Angular speed from the video and the gyro, before and after, as a PNG.
 void Plot(const steadiface::CalibrationResult& r, const std::string& path) {
@@ -71,7 +73,7 @@ class Feeder {
          steadiface_ros::CameraInfoSource* info_source)
       : o_(o), po_(po), info_source_(*info_source) {}
   // Reads every message of `queue`; an error ends the run.
-  Status Feed(steadiface_bag::BoundedQueue<steadiface_bag::BagItem>* queue, size_t total);
+  Status Feed(Queue* queue, size_t total);
   std::unique_ptr<steadiface::Calibrator>& calibrator() { return cal_; }
   size_t frames() const { return frames_; }
   size_t skipped() const { return skipped_; }
@@ -132,7 +134,7 @@ Status Feeder::AddImage(const sensor_msgs::Image& image) {
   return Status::Ok();
 }
 
-Status Feeder::Feed(steadiface_bag::BoundedQueue<steadiface_bag::BagItem>* queue, size_t total) {
+Status Feeder::Feed(Queue* queue, size_t total) {
   steadiface_bag::BagItem item;
   while (queue->Pop(&item)) {
     if (item.imu) AddGyro(*item.imu);
@@ -237,30 +239,53 @@ void PrintSummary(const steadiface::CalibrationResult& r, const std::string& out
             << " px; wrote " << out << "\n";
 }
 
-// Reads the bag into a Calibrator and solves; the error says why not.
-Status Calibrate(const CalibrateOptions& o, steadiface::CalibrationResult* r, size_t* frames,
-                 size_t* imu) {
-  steadiface::PipelineOptions po;
-  steadiface_ros::WrapperOptions wo;
-  // The starting point: the package defaults and the user's overlays.
-  Status st = steadiface_ros::LoadPackageOptions(o.params, &po, &wo);
+// The recording and what reading it needs: the package defaults with the
+// user's overlays (the starting point), the camera_info source and the
+// bag, opened once; then its messages, read on the reader's thread and
+// handed to one of the two calibrations.
+class Recording {
+ public:
+  explicit Recording(const CalibrateOptions& o)
+      : o_(o), info_source_([this](bool is_error, const std::string& text) {
+          if (is_error || !o_.quiet) std::cerr << "steadiface_calibrate: " << text << "\n";
+        }),
+        reader_(o.in, o.topics) {}
+  Status Open() {
+    Status st = steadiface_ros::LoadPackageOptions(o_.params, &po_, &wo_);
+    if (st.ok()) st = info_source_.Load(wo_.camera_info_url);
+    if (st.ok()) st = reader_.Open(/*info_required=*/!info_source_.has_file_info());
+    return st;
+  }
+  bool has_imu() const { return reader_.ImuCount() > 0; }
+  size_t images() const { return reader_.ImageCount(); }
+  const steadiface::PipelineOptions& options() const { return po_; }
+  steadiface_ros::CameraInfoSource* info_source() { return &info_source_; }
+  // Every message through `feed`; its error, else the reader's.
+  Status Read(const std::function<Status(Queue*)>& feed) {
+    Queue queue(64);
+    reader_.Start(&queue);
+    const Status st = feed(&queue);
+    if (!st.ok()) queue.Close();
+    const std::string reader_error = reader_.Join();
+    if (!st.ok()) return st;
+    return reader_error.empty() ? Status::Ok() : Status::Error(reader_error);
+  }
+
+ private:
+  const CalibrateOptions& o_;
+  steadiface::PipelineOptions po_;
+  steadiface_ros::WrapperOptions wo_;
+  steadiface_ros::CameraInfoSource info_source_;
+  steadiface_bag::BagReader reader_;
+};
+
+// Reads the recording into a Calibrator and solves; the error says why not.
+Status Calibrate(const CalibrateOptions& o, Recording* rec, steadiface::CalibrationResult* r,
+                 size_t* frames, size_t* imu) {
+  Feeder feeder(o, rec->options(), rec->info_source());
+  const size_t total = rec->images();
+  Status st = rec->Read([&](Queue* queue) { return feeder.Feed(queue, total); });
   if (!st.ok()) return st;
-  const bool quiet = o.quiet;
-  steadiface_ros::CameraInfoSource info_source([quiet](bool is_error, const std::string& text) {
-    if (is_error || !quiet) std::cerr << "steadiface_calibrate: " << text << "\n";
-  });
-  st = info_source.Load(wo.camera_info_url);
-  steadiface_bag::BagReader reader(o.in, o.topics);
-  if (st.ok()) st = reader.Open(/*info_required=*/!info_source.has_file_info());
-  if (!st.ok()) return st;
-  steadiface_bag::BoundedQueue<steadiface_bag::BagItem> queue(64);
-  reader.Start(&queue);
-  Feeder feeder(o, po, &info_source);
-  st = feeder.Feed(&queue, reader.ImageCount());
-  if (!st.ok()) queue.Close();
-  const std::string reader_error = reader.Join();
-  if (!st.ok()) return st;
-  if (!reader_error.empty()) return Status::Error(reader_error);
   if (!feeder.calibrator()) {
     return Status::Error("no usable image in '" + o.in + "' (" +
                          std::to_string(feeder.skipped()) + " skipped)");
@@ -273,8 +298,7 @@ Status Calibrate(const CalibrateOptions& o, steadiface::CalibrationResult* r, si
 
 // Without an IMU: the readout from the video alone, fed frame by frame.
 Status FeedVideo(const steadiface::PipelineOptions& po,
-                 steadiface_ros::CameraInfoSource* info_source,
-                 steadiface_bag::BoundedQueue<steadiface_bag::BagItem>* queue,
+                 steadiface_ros::CameraInfoSource* info_source, Queue* queue,
                  std::unique_ptr<steadiface::VideoReadoutEstimator>* est) {
   steadiface_bag::BagItem item;
   sensor_msgs::CameraInfoConstPtr last_info;
@@ -301,27 +325,12 @@ Status FeedVideo(const steadiface::PipelineOptions& po,
   return Status::Ok();
 }
 
-Status CalibrateFromVideo(const CalibrateOptions& o, steadiface::VideoReadoutResult* r,
-                          int* frames) {
-  steadiface::PipelineOptions po;
-  steadiface_ros::WrapperOptions wo;
-  Status st = steadiface_ros::LoadPackageOptions(o.params, &po, &wo);
-  if (!st.ok()) return st;
-  steadiface_ros::CameraInfoSource info_source([](bool, const std::string& text) {
-    std::cerr << "steadiface_calibrate: " << text << "\n";
-  });
-  st = info_source.Load(wo.camera_info_url);
-  steadiface_bag::BagReader reader(o.in, o.topics);
-  if (st.ok()) st = reader.Open(/*info_required=*/!info_source.has_file_info());
-  if (!st.ok()) return st;
-  steadiface_bag::BoundedQueue<steadiface_bag::BagItem> queue(64);
-  reader.Start(&queue);
+Status CalibrateFromVideo(const CalibrateOptions& o, Recording* rec,
+                          steadiface::VideoReadoutResult* r, int* frames) {
   std::unique_ptr<steadiface::VideoReadoutEstimator> est;
-  st = FeedVideo(po, &info_source, &queue, &est);
-  if (!st.ok()) queue.Close();
-  const std::string reader_error = reader.Join();
+  const Status st = rec->Read(
+      [&](Queue* queue) { return FeedVideo(rec->options(), rec->info_source(), queue, &est); });
   if (!st.ok()) return st;
-  if (!reader_error.empty()) return Status::Error(reader_error);
   if (!est) return Status::Error("no usable image in '" + o.in + "'");
   *r = est->Estimate();
   *frames = est->frames();
@@ -352,10 +361,10 @@ Status WriteVideoOverlay(const steadiface::VideoReadoutResult& r, const std::str
 }
 
 // A recording without IMU messages: the readout from the video alone.
-int RunVideoCalibration(const CalibrateOptions& o) {
+int RunVideoCalibration(const CalibrateOptions& o, Recording* rec) {
   steadiface::VideoReadoutResult r;
   int frames = 0;
-  Status st = CalibrateFromVideo(o, &r, &frames);
+  Status st = CalibrateFromVideo(o, rec, &r, &frames);
   if (st.ok()) st = WriteVideoOverlay(r, o.in, frames, o.out);
   if (!st.ok()) {
     std::cerr << "steadiface_calibrate: " << st.message() << "\n";
@@ -374,21 +383,16 @@ int RunVideoCalibration(const CalibrateOptions& o) {
   return 0;
 }
 
-// Whether the recording has IMU messages (an unreadable bag: true, so that
-// the IMU calibration reports why).
-bool HasImu(const CalibrateOptions& o) {
-  steadiface_bag::BagReader reader(o.in, o.topics);
-  if (!reader.Open(/*info_required=*/false).ok()) return true;
-  return reader.ImuCount() > 0;
-}
-
 }  // namespace
 
 int RunCalibration(const CalibrateOptions& o) {
-  if (!HasImu(o)) return RunVideoCalibration(o);
+  Recording rec(o);
+  Status st = rec.Open();
+  // Without IMU messages, the readout from the video alone.
+  if (st.ok() && !rec.has_imu()) return RunVideoCalibration(o, &rec);
   steadiface::CalibrationResult r;
   size_t frames = 0, imu = 0;
-  Status st = Calibrate(o, &r, &frames, &imu);
+  if (st.ok()) st = Calibrate(o, &rec, &r, &frames, &imu);
   if (st.ok()) st = WriteOverlay(r, o.in, frames, o.out);
   if (!st.ok()) {
     std::cerr << "steadiface_calibrate: " << st.message() << "\n";
