@@ -14,6 +14,7 @@
 #include "steadiface_bag/bounded_queue.h"
 #include "steadiface_core/calibration/calibrator.h"
 #include "steadiface_core/calibration/video_readout.h"
+#include "steadiface_core/common/grey.h"
 #include "steadiface_ros/camera_info_source.h"
 #include "steadiface_ros/msg_conversion.h"
 #include "steadiface_ros/params.h"
@@ -306,7 +307,7 @@ Status FeedVideo(const steadiface::PipelineOptions& po,
     if (item.info) last_info = item.info;
     if (!item.image) continue;
     const sensor_msgs::CameraInfoConstPtr info = info_source->Select(*item.image, last_info);
-    cv::Mat image, grey;
+    cv::Mat image;
     if (!info || !steadiface_ros::ToCvImage(*item.image, &image).ok()) continue;
     if (!*est) {
       steadiface::CameraIntrinsics k;
@@ -314,12 +315,8 @@ Status FeedVideo(const steadiface::PipelineOptions& po,
       if (st.ok()) st = steadiface::VideoReadoutEstimator::Create(k, po.shutter, {}, est);
       if (!st.ok()) return st;
     }
-    if (image.channels() == 1) {
-      grey = image;
-    } else {
-      cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
-    }
-    const Status st = (*est)->AddFrame(grey, steadiface_ros::ToCoreTime(item.image->header.stamp));
+    const Status st = (*est)->AddFrame(steadiface::ToGrey(image),
+                                       steadiface_ros::ToCoreTime(item.image->header.stamp));
     if (!st.ok()) return st;
   }
   return Status::Ok();
