@@ -130,8 +130,7 @@ Status VideoReadoutEstimator::AddFrame(const cv::Mat& grey, Time stamp) {
 VideoReadoutResult VideoReadoutEstimator::Estimate() const {
   VideoReadoutResult out;
   // The rate of change within a pair (fitted with r0) against the one
-  // across the neighbouring pairs, per axis.
-  // Both are low-passed alike (a Gaussian over kSigma pairs): the rows'
+  // across the neighbouring pairs, per axis. Both are low-passed alike (a Gaussian over kSigma pairs): the rows'
   // spread within a pair sees the difference of the instantaneous rates one
   // frame apart, the pairs' rates are means over a frame, and the two agree
   // only well below the frame rate (at f: 2 pi f T / sin(2 pi f T); 1.07 at
@@ -161,7 +160,9 @@ VideoReadoutResult VideoReadoutEstimator::Estimate() const {
       across.push_back(fd[i] / wsum);
       within.push_back(al[i] / wsum);
     }
-    // The low-passed rate and its change, without their means (a pan).
+    // The low-passed rate and its change, for the shake's RMS frequency.
+    // The rate's mean is not removed: a pan lowers that frequency, and the
+    // correction below with it.
     rate2 += (om / wsum).squaredNorm();
     accel2 += (fd / wsum).squaredNorm();
     spacing += ToSeconds(pairs_[n + 1].stamp - pairs_[n].stamp);

@@ -15,6 +15,7 @@
 
 #include "steadiface_core/common/so3.h"
 #include "steadiface_core/layered/layer_blend.h"
+#include "eval/longest_run.h"
 
 namespace steadiface {
 namespace eval {
@@ -33,19 +34,6 @@ bool LargestSteps(const std::vector<Eigen::Vector2d>& p, double* step, double* a
     }
   }
   return any;
-}
-
-// The longest run [first, second) of consecutive indices in [0, n) where
-// `ok(i)` holds; the first such run on ties, empty if there is none.
-template <typename Pred>
-std::pair<size_t, size_t> LongestRun(size_t n, Pred ok) {
-  std::pair<size_t, size_t> best(0, 0);
-  for (size_t i = 0, start = 0; i <= n; ++i) {
-    if (i < n && ok(i)) continue;
-    if (i - start > best.second - best.first) best = {start, i};
-    start = i + 1;
-  }
-  return best;
 }
 
 // Power spectrum of a real series (DFT), bins 0..n/2.

@@ -7,6 +7,7 @@
 #include "steadiface_core/common/high_pass_rms.h"
 #include "steadiface_core/common/percentile.h"
 #include "steadiface_core/eval/scorecard.h"
+#include "eval/longest_run.h"
 
 namespace steadiface {
 namespace eval {
@@ -20,12 +21,8 @@ double Angle(const Eigen::Quaterniond& q) { return Eigen::AngleAxisd(q.normalize
 double WindowRms(const std::vector<Eigen::Vector2d>& traj, const std::vector<bool>& window,
                  double fps, double cutoff_hz, size_t min_run, int* covered) {
   *covered = 0;
-  size_t best_first = 0, best_len = 0;
-  for (size_t i = 0, start = 0; i <= traj.size(); ++i) {
-    if (i < traj.size() && traj[i].allFinite()) continue;
-    if (i - start > best_len) best_first = start, best_len = i - start;
-    start = i + 1;
-  }
+  const auto longest = LongestRun(traj.size(), [&traj](size_t i) { return traj[i].allFinite(); });
+  const size_t best_first = longest.first, best_len = longest.second - longest.first;
   if (best_len < min_run) return 0.0;
   const std::vector<Eigen::Vector2d> run(traj.begin() + best_first,
                                          traj.begin() + best_first + best_len);
