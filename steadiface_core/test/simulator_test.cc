@@ -63,6 +63,42 @@ TEST(SimulatorTest, WithoutCameraMotionTheHeadCentreFollowsOnlyTheHead) {
   }
 }
 
+TEST(SimulatorTest, AReliefHeadTurnsAboutItsSkullAndItsFaceMovesAsARealOneDoes) {
+  // Still camera; the head only turns (yaw up to 1.2 rad). The pose-invariant
+  // head stays put; the face's landmark centre swings sideways by the pivot
+  // depth times sin(yaw), in px fx d sin(yaw) / Z; the flat face barely moves.
+  auto turning = [](const std::string& model) {
+    return MakeSimulator("still", [&model](sim::SimulatorOptions* o) {
+      o->head_model = model;
+      o->head = sim::HeadMotionOptions();
+      o->head.bob_amplitude_m = o->head.sway_amplitude_m = o->head.jitter_rms_m = 0.0;
+      o->head.pitch_amplitude_rad = o->head.lean_amplitude_m = 0.0;
+      o->head.yaw_amplitude_rad = 1.2;
+      o->head.yaw_hz = 0.25;
+    });
+  };
+  auto relief = turning("relief"), flat = turning("flat");
+  const double d = relief->options().relief.pivot_depth_m, Z = relief->options().head.distance_m;
+  const sim::SimTruth t0 = relief->Truth(0);
+  double largest_swing = 0.0, flat_swing = 0.0;
+  for (int i = 0; i < relief->num_frames(); i += 5) {
+    const sim::SimTruth t = relief->Truth(i);
+    EXPECT_NEAR((t.head_px - t0.head_px).norm(), 0.0, 1e-6) << i;
+    // The face point swings by d sin(yaw) sideways and d (1 - cos yaw) away
+    // from the camera, about the head at lateral offset X0.
+    const double fx = relief->intrinsics().fx, cx = relief->intrinsics().cx;
+    const double X0 = (t.head_px.x() - cx) * Z / fx;
+    const double expected =
+        fx * (X0 - d * std::sin(t.yaw)) / (Z + d * (1.0 - std::cos(t.yaw))) - fx * X0 / Z;
+    EXPECT_NEAR(t.face_px.x() - t.head_px.x(), expected, 0.3) << i;
+    largest_swing = std::max(largest_swing, std::abs(t.face_px.x() - t.head_px.x()));
+    const sim::SimTruth f = flat->Truth(i);
+    flat_swing = std::max(flat_swing, std::abs(f.face_px.x() - f.head_px.x()));
+  }
+  EXPECT_GT(largest_swing, 60.0);
+  EXPECT_LT(flat_swing, 5.0);
+}
+
 TEST(SimulatorTest, PureRotationMovesTheSceneByKRKinv) {
   // Shake only (no translation, no body or head motion), global shutter:
   // every point, near or far, moves by K R K^-1 between frames.

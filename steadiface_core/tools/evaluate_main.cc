@@ -46,6 +46,10 @@ const char kUsage[] =
     "         trace: scale its rotation, or play it K times as fast)\n"
     "       [--search-interval S] (face.search_interval: full-frame face search\n"
     "         at most once per S while no face is locked; 0 = every frame)\n"
+    "       [--head-model relief|flat] (the simulated head: a relief that turns\n"
+    "         about its skull, the default, or the flat photo)\n"
+    "       [--pivot-depth D] (dynamic.pose_pivot_depth: the pose-invariant head\n"
+    "         centre, D face scales behind the landmarks; 0 = the paper's centre)\n"
     "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
     "         shows a 30 px face)\n"
     "       [--crop-mode fixed|dynamic] (output.crop: the fixed crop ratio, or the\n"
@@ -91,6 +95,10 @@ void AddRunFlags(CommandLine* cl, EvaluationOptions* o) {
   });
   cl->Double("--gyro-scale", &o->gyro_scale).Double("--gyro-speed", &o->gyro_speed);
   cl->Double("--head-distance", &o->head_distance_m);
+  cl->Value("--head-model", "relief or flat", [o](const std::string& v) {
+    o->head_model = v;
+    return v == "relief" || v == "flat";
+  });
   cl->Flag("--feasible-set", &o->feasible_set).Double("--feasible-roll", &o->feasible_roll);
   cl->Flag("--reach-tube", &o->reach_tube).Flag("--composite-frames", &o->composite_frames);
   cl->Int("--average15", &o->average_at);
@@ -111,6 +119,7 @@ void AddPipelineFlags(CommandLine* cl, EvaluationOptions* o) {
     return std::sscanf(v.c_str(), "%lf,%lf", &o->window_s.x(), &o->window_s.y()) == 2 &&
            o->window_s.y() > o->window_s.x();
   });
+  cl->Double("--pivot-depth", &o->pose_pivot_depth);
   cl->Double("--head-w-stay", &o->head_w_stay).Double("--head-d-ref", &o->head_d_ref);
   cl->Double("--subject-reach", &o->subject_reach).Double("--reach-lowpass", &o->reach_lowpass_hz);
   cl->Double("--reach-hold", &o->reach_hold);

@@ -77,6 +77,7 @@ Status MakeSimulator(const EvaluationOptions& o, const std::string& preset,
   if (std::isfinite(o.gyro_scale)) so->real_gyro_scale = o.gyro_scale;
   if (std::isfinite(o.gyro_speed)) so->real_gyro_speed = o.gyro_speed;
   if (std::isfinite(o.head_distance_m)) so->head.distance_m = o.head_distance_m;
+  if (!o.head_model.empty()) so->head_model = o.head_model;
   if (s.ok()) s = sim::Simulator::Create(*so, sim);
   if (s.ok() && !std::isfinite(o.duration_s) && (*sim)->real_gyro_span_s() > so->duration_s) {
     // The whole recorded trace once (a 3 s slice of it is a poor sample).
@@ -107,6 +108,9 @@ Status PipelineOptionsFor(const EvaluationOptions& o, const sim::Simulator& sim,
   po.rotation_source = o.rotation_source;
   if (std::isfinite(o.head_w_stay)) po.stabilizer.head.w_stay = o.head_w_stay;
   if (std::isfinite(o.head_d_ref)) po.stabilizer.head.d_ref = o.head_d_ref;
+  if (std::isfinite(o.pose_pivot_depth)) {
+    po.stabilizer.dynamic.pose_pivot_depth = o.pose_pivot_depth;
+  }
   po.stabilizer.subject_reach = o.subject_reach;
   if (std::isfinite(o.reach_lowpass_hz)) {
     po.stabilizer.subject_reach_lowpass_hz = o.reach_lowpass_hz;

@@ -51,6 +51,7 @@ void FaceTracker::Reset() {
   last_landmarks_.clear();
   reference_shape_.clear();
   reference_patch_.release();
+  reference_yaw_ = 0.0;
   have_last_rotation_ = false;
   frames_since_detect_ = 0;
   frames_tracked_ = 0;
@@ -99,6 +100,21 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
     pinhole.distortion = DistortionModel::kNone;
     info->has_pose = EstimateHeadPose(head_model_, ideal, pinhole, &info->yaw, &info->pitch, &info->roll);
     info->timings.pose_ms = MsSince(t0);
+  }
+  Relock(c, acquiring, patch, *info);
+}
+
+void FaceTracker::Relock(const Candidate& c, bool acquiring, const cv::Mat& patch,
+                         const FaceInfo& info) {
+  // The references follow the face towards the camera (never away from it).
+  if (!info.has_pose || !std::isfinite(info.yaw)) return;
+  if (acquiring) {
+    reference_yaw_ = std::abs(info.yaw);
+  } else if (options_.relock_yaw_step_rad > 0.0 &&
+             std::abs(info.yaw) < reference_yaw_ - options_.relock_yaw_step_rad) {
+    reference_shape_ = Normalize(c.landmarks);
+    if (!patch.empty()) reference_patch_ = patch.clone();
+    reference_yaw_ = std::abs(info.yaw);
   }
 }
 

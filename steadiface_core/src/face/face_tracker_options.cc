@@ -38,6 +38,8 @@ Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
     err << "face.min_region_appearance must be in [-1, 1), got " << o.min_region_appearance;
   } else if (o.appearance_patch_px < 16 || o.appearance_patch_px > 256) {
     err << "face.appearance_patch_px must be in [16, 256], got " << o.appearance_patch_px;
+  } else if (!(o.relock_yaw_step_rad >= 0.0 && o.relock_yaw_step_rad <= 1.0)) {
+    err << "face.relock_yaw_step_rad must be in [0, 1], got " << o.relock_yaw_step_rad;
   } else if (!(o.appearance_update_rate >= 0.0 && o.appearance_update_rate <= 1.0)) {
     err << "face.appearance_update_rate must be in [0, 1], got "
         << o.appearance_update_rate;

@@ -38,21 +38,12 @@ LandmarkSequence::LandmarkSequence(const CameraModel& model,
     fr.q_wc_mid = camera_.Orientation(t_mid);
     fr.true_centre.setZero();
     for (const Eigen::Vector3d& X_head : face) {
-      double y = 0.5 * (k.height - 1);
-      Eigen::Vector2d px;
-      for (int it = 0; it < 8; ++it) {
-        const double t = ToSeconds(timing_.RowTime(fr.stamp, y));
-        const Eigen::Vector3d X_w =
-            head_.Orientation(t) * X_head + head_.Position(t) + Body(t);
-        const Eigen::Vector3d X_c = camera_.Orientation(t).conjugate() *
-                                    (X_w - camera_.Position(t) - Body(t));
-        px = Eigen::Vector2d(k.fx * X_c.x() / X_c.z() + k.cx,
-                             k.fy * X_c.y() / X_c.z() + k.cy);
-        y = px.y();
-      }
+      Eigen::Vector2d px = Project(fr.stamp, X_head, true);
       fr.true_landmarks.push_back(model.PixelToNormalized(px));
       fr.true_rows.push_back(px.y());
-      fr.true_centre += fr.true_landmarks.back();
+      // The pose-invariant head: the landmarks as they would be seen with
+      // the head facing forward.
+      fr.true_centre += model.PixelToNormalized(Project(fr.stamp, X_head, false));
       Eigen::Vector2d noisy = px;
       if (options.landmark_noise_px > 0) {
         noisy += options.landmark_noise_px * Eigen::Vector2d(n01(rng), n01(rng));
@@ -74,6 +65,26 @@ LandmarkSequence::LandmarkSequence(const CameraModel& model,
     ComputeCentreAndScale(&fr.observed);
     frames_.push_back(std::move(fr));
   }
+}
+
+Eigen::Vector2d LandmarkSequence::Project(Time stamp, const Eigen::Vector3d& X_head,
+                                          bool turned) const {
+  // The head turns about its skull's centre, pivot_depth_m behind the eyes
+  // (as the simulator's relief head does); at its own row.
+  const CameraIntrinsics& k = model_.intrinsics();
+  const Eigen::Vector3d pivot(0.0, 0.0, options_.pivot_depth_m);
+  double y = 0.5 * (k.height - 1);
+  Eigen::Vector2d px;
+  for (int it = 0; it < 8; ++it) {
+    const double t = ToSeconds(timing_.RowTime(stamp, y));
+    const Eigen::Quaterniond R = turned ? head_.Orientation(t) : Eigen::Quaterniond::Identity();
+    const Eigen::Vector3d X_w = R * (X_head - pivot) + pivot + head_.Position(t) + Body(t);
+    const Eigen::Vector3d X_c =
+        camera_.Orientation(t).conjugate() * (X_w - camera_.Position(t) - Body(t));
+    px = Eigen::Vector2d(k.fx * X_c.x() / X_c.z() + k.cx, k.fy * X_c.y() / X_c.z() + k.cy);
+    y = px.y();
+  }
+  return px;
 }
 
 Eigen::Vector3d LandmarkSequence::Body(double t) const {

@@ -6,13 +6,16 @@
 #include <Eigen/LU>
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/sim/head_relief.h"
+
 namespace steadiface {
 namespace sim {
 
 Eigen::Vector3d Billboard::WorldPoint(const Eigen::Vector2d& uv, double t) const {
   const Pose P = pose(t);
   const Eigen::Vector2d local = (uv - anchor_px) * metres_per_px;
-  return P.R * Eigen::Vector3d(local.x(), local.y(), 0.0) + P.p;
+  const double z = depth_m.empty() ? 0.0 : ReliefDepth(depth_m, uv);
+  return P.R * Eigen::Vector3d(local.x(), local.y(), z) + P.p;
 }
 
 Billboard MakeFaceBillboard(const cv::Mat& photo, const cv::Rect& region,
@@ -43,6 +46,10 @@ namespace {
 void RenderBoard(const CameraIntrinsics& k, const std::function<double(double)>& row_time,
                  const std::function<Pose(double)>& camera_pose, const Billboard* b, int band,
                  cv::Mat* layer) {
+  if (!b->depth_m.empty()) {
+    RenderRelief(k, row_time, camera_pose, *b, band, layer);
+    return;
+  }
   const Eigen::Matrix3d K =
       (Eigen::Matrix3d() << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1).finished();
   cv::Mat map_x(k.height, k.width, CV_32FC1), map_y(k.height, k.width, CV_32FC1);

@@ -255,6 +255,17 @@ Status Simulator::Create(const SimulatorOptions& options, std::unique_ptr<Simula
       !(o.real_gyro_speed > 0.0 && o.real_gyro_speed <= 10.0)) {
     return Status::Error("sim: real_gyro_scale and real_gyro_speed must be in (0, 10]");
   }
+  if (o.head_model != "relief" && o.head_model != "flat") {
+    return Status::Error("sim: head_model must be relief or flat");
+  }
+  if (!(o.relief.pivot_depth_m > 0.0 && o.relief.pivot_depth_m < 0.5) ||
+      !(o.relief.outline_radius > 0.1 && o.relief.outline_radius <= 1.0) ||
+      !(std::abs(o.relief.nose_height_m) < 0.1) || !(o.relief.nose_sigma_x > 0.0) ||
+      !(o.relief.nose_sigma_y > 0.0) || !std::isfinite(o.relief.nose_below)) {
+    return Status::Error(
+        "sim: relief pivot depth in (0, 0.5) m, outline radius in (0.1, 1], "
+        "nose height under 0.1 m, nose sigmas positive");
+  }
   if (!(o.background_contrast > 0.0 && o.background_contrast <= 1.0) ||
       !(o.background_blur_px >= 0.0 && o.background_blur_px <= 50.0)) {
     return Status::Error("sim: background_contrast must be in (0, 1], background_blur_px in [0, 50]");
@@ -279,20 +290,12 @@ Status Simulator::Init() {
   const double m_per_px = o.face_width_m / o.face_width_px;
   face_ = MakeFaceBillboard(photo, o.face_region, o.face_region.width * m_per_px);
   face_centre_uv_ = o.face_centre_px - Eigen::Vector2d(o.face_region.x, o.face_region.y);
-  face_.pose = [this](double t) {
-    Pose P;
-    P.R = head_.Orientation(t);
-    P.p = head_.Position(t) + Body(t);
-    P = Orbit(P, t);
-    const SimulatorOptions& so = options_;
-    if (so.face_out_start_s >= 0) {
-      // Sideways out of view and back.
-      const double out = Ramp(t, so.face_out_start_s, so.face_out_start_s + 0.4) -
-                         Ramp(t, so.face_out_end_s, so.face_out_end_s + 0.4);
-      P.p.x() += 0.6 * out;
-    }
-    return P;
-  };
+  if (o.head_model == "relief") {
+    face_.depth_m = MakeHeadRelief(face_.bgra.size(), face_centre_uv_, o.face_width_px, o.relief);
+    const Eigen::Vector2d c = (face_centre_uv_ - face_.anchor_px) * face_.metres_per_px;
+    turning_centre_ = Eigen::Vector3d(c.x(), c.y(), o.relief.pivot_depth_m);
+  }
+  face_.pose = [this](double t) { return FacePose(t, true); };
   if (o.hair_edge) MakeHair();
   MakeTorso();
   MakeSecondFaceAndOccluder(photo, m_per_px);
@@ -393,6 +396,22 @@ double Simulator::RealGyroTime(double t, double* sign) const {
   return u;
 }
 
+Pose Simulator::FacePose(double t, bool turned) const {
+  Pose P;
+  if (turned) P.R = head_.Orientation(t);
+  // Turned about the turning centre: it stays where it is unturned.
+  P.p = head_.Position(t) + Body(t) + turning_centre_ - P.R * turning_centre_;
+  P = Orbit(P, t);
+  const SimulatorOptions& so = options_;
+  if (so.face_out_start_s >= 0) {
+    // Sideways out of view and back.
+    const double out = Ramp(t, so.face_out_start_s, so.face_out_start_s + 0.4) -
+                       Ramp(t, so.face_out_end_s, so.face_out_end_s + 0.4);
+    P.p.x() += 0.6 * out;
+  }
+  return P;
+}
+
 Pose Simulator::Orbit(const Pose& P, double t) const {
   if (!options_.pan_orbits_head || options_.camera.pan_rate == 0.0) return P;
   const Eigen::Quaterniond R_pan(
@@ -440,11 +459,18 @@ SimTruth Simulator::Truth(int i) const {
   }
   auto row_time = [&](double y) { return RowTimeS(tr.stamp, y); };
   auto cam = [this](double t) { return CameraPose(t); };
-  const bool visible = ProjectRollingShutter(
-      k, row_time, cam, [&](double t) { return face_.WorldPoint(face_centre_uv_, t); },
-      &tr.head_px);
+  const Eigen::Vector2d centre = (face_centre_uv_ - face_.anchor_px) * face_.metres_per_px;
+  const Eigen::Vector3d front(centre.x(), centre.y(), 0.0);
+  const bool visible = ProjectRollingShutter(k, row_time, cam, [&](double t) {
+    const Pose P = FacePose(t, false);
+    return Eigen::Vector3d(P.R * front + P.p);
+  }, &tr.head_px);
   tr.head_in_view = options_.render_face && visible && tr.head_px.x() >= 0 && tr.head_px.y() >= 0 &&
                     tr.head_px.x() <= k.width - 1 && tr.head_px.y() <= k.height - 1;
+  ProjectRollingShutter(k, row_time, cam, [&](double t) {
+    const Pose P = FacePose(t, true);
+    return Eigen::Vector3d(P.R * front + P.p);
+  }, &tr.face_px);
   Eigen::Vector2d a, b;
   const double half = 0.5 * options_.face_width_px;
   if (ProjectRollingShutter(k, row_time, cam, [&](double t) {
@@ -455,6 +481,8 @@ SimTruth Simulator::Truth(int i) const {
       }, &b)) {
     tr.face_scale_px = (b - a).norm();
   }
+  tr.yaw = head_.Yaw(ToSeconds(timing_.RowTime(tr.stamp, 0.5 * (k.height - 1))));
+  tr.pitch = head_.Pitch(ToSeconds(timing_.RowTime(tr.stamp, 0.5 * (k.height - 1))));
   const double t = ToSeconds(tr.stamp);
   const SimulatorOptions& o = options_;
   tr.occluded = Active(t, o.occlusion_start_s + 0.3 * (o.occlusion_end_s - o.occlusion_start_s),
@@ -546,16 +574,9 @@ bool Simulator::SubjectCovers(int i, const Eigen::Vector2d& px) const {
   const Eigen::Vector3d ray =
       C.R * Eigen::Vector3d((px.x() - k.cx) / k.fx, (px.y() - k.cy) / k.fy, 1.0);
   auto covers = [&](const Billboard& b) {
-    const Pose P = b.pose(t);
-    const Eigen::Vector3d n = P.R * Eigen::Vector3d::UnitZ();
-    const double den = n.dot(ray);
-    if (std::abs(den) < 1e-12) return false;
-    const double s = n.dot(P.p - C.p) / den;
-    if (s <= 0) return false;
-    const Eigen::Vector3d local = P.R.conjugate() * (C.p + s * ray - P.p);
-    const Eigen::Vector2d uv = local.head<2>() / b.metres_per_px + b.anchor_px;
+    Eigen::Vector2d uv;
+    if (!IntersectRelief(b, b.pose(t), C.p, ray, &uv)) return false;
     const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
-    if (x < 0 || y < 0 || x >= b.bgra.cols || y >= b.bgra.rows) return false;
     return b.bgra.at<cv::Vec4b>(y, x)[3] >= 128;
   };
   return covers(face_) || (options_.render_torso && covers(torso_));

@@ -37,8 +37,8 @@ void Simulator::MakeTorso() {
   torso_.metres_per_px = m;
   torso_.anchor_px = Eigen::Vector2d(0.5 * (tw - 1), 0.0);
   torso_.pose = [this](double t) {
-    Pose P = face_.pose(t);
     // The face billboard's position without its turning and nodding.
+    const Pose P = FacePose(t, false);
     const Eigen::Vector3d centre = P.p + P.R * Eigen::Vector3d(
         (face_centre_uv_.x() - face_.anchor_px.x()) * face_.metres_per_px,
         (face_centre_uv_.y() - face_.anchor_px.y()) * face_.metres_per_px, 0.0);
@@ -120,7 +120,7 @@ void Simulator::MakeSecondFaceAndOccluder(const cv::Mat& photo, double m_per_px)
   occluder_.pose = [this](double t) {
     const SimulatorOptions& so = options_;
     const double s = Ramp(t, so.occlusion_start_s, so.occlusion_end_s);
-    Pose P = face_.pose(t);
+    Pose P = FacePose(t, false);
     P.R = Eigen::Quaterniond::Identity();
     P.p.z() -= 0.15;
     P.p.x() += -0.25 + 0.5 * s;

@@ -70,6 +70,7 @@ Stabilizer::Stabilizer(const CameraModel& model, const OutputGeometry& output,
       options_(options),
       smoother_(options.head),
       dynamic_(options.dynamic),
+      pose_centre_(options.dynamic.pose_pivot_depth, options.dynamic.pose_yaw_time_constant_s),
       background_dynamic_(options.dynamic),
       reach_anchor_(ReachAnchorHz(options)) {}
 
@@ -89,6 +90,8 @@ Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
   smoother_ = HeadSmoother(options.head);
   dynamic_.set_options(options.dynamic);
   background_dynamic_.set_options(options.dynamic);
+  pose_centre_ = PoseInvariantCentre(options.dynamic.pose_pivot_depth,
+                                     options.dynamic.pose_yaw_time_constant_s);
   if (!options.background_layer) background_ = LayerState();
   return Status::Ok();
 }
@@ -106,6 +109,7 @@ void Stabilizer::Reset() {
   has_held_face_ = false;
   dynamic_.Reset();
   background_dynamic_.Reset();
+  pose_centre_.Reset();
   reach_anchor_fed_ = false;
   ++stats_.resets;
 }
@@ -122,6 +126,15 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   if (!s.ok()) return s;
 
   const bool use_face = FaceUsable(face, options_);
+  // The landmarks moved to the pose-invariant head centre: E_f, Eq. 1 and
+  // the held face read it.
+  FaceObservation invariant;
+  if (use_face) {
+    invariant = pose_centre_.Apply(*face, dt);
+    face = &invariant;
+  } else {
+    pose_centre_.Reset();
+  }
   // A camera fixed in the world at the epoch's first real rotation: what
   // it sees does not depend on where the gyro integration started.
   if (layer.history == 0) R_reference_ = f.R_r;

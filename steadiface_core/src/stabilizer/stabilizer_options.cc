@@ -58,6 +58,8 @@ Status ValidateStabilizerOptions(const StabilizerOptions& o) {
       Range("dynamic.pose_high", d.pose_high_rad, d.pose_low_rad + 1e-6, 3.2),
       Range("dynamic.pose_min_fit_scale", d.pose_min_fit_scale, 0, 1),
       Range("dynamic.pose_smoothness_boost", d.pose_smoothness_boost, 0, 100),
+      Range("dynamic.pose_pivot_depth", d.pose_pivot_depth, 0, 10),
+      Range("dynamic.pose_yaw_time_constant", d.pose_yaw_time_constant_s, 0, 10),
       Range("dynamic.variation_window", d.variation_window, 3, 1000),
       Range("dynamic.centre_variation_low", d.centre_variation_low, 0, 1),
       Range("dynamic.centre_variation_high", d.centre_variation_high,

@@ -61,6 +61,8 @@ struct EvaluationOptions {
   double gyro_scale = NAN, gyro_speed = NAN;
   /// The subject's distance [m].
   double head_distance_m = NAN;
+  /// The simulated head: relief or flat (empty: the simulator's default).
+  std::string head_model;
 
   /// output.crop_ratio [-].
   double crop = NAN;
@@ -73,6 +75,8 @@ struct EvaluationOptions {
   Eigen::Vector2d window_s = Eigen::Vector2d::Constant(NAN);
   /// head.w_stay [-] and head.d_ref [fraction of the width].
   double head_w_stay = NAN, head_d_ref = NAN;
+  /// dynamic.pose_pivot_depth: the pose-invariant head centre [face scales].
+  double pose_pivot_depth = NAN;
   /// stabilizer.subject_reach [jaw widths] (0: off), its low-pass [Hz] and hold.
   double subject_reach = 0.0, reach_lowpass_hz = NAN, reach_hold = NAN;
   /// Added to imu/time_offset and camera/readout_time [s] (calibration

@@ -68,6 +68,13 @@ struct FaceTrackerOptions {
   int appearance_patch_px = 40;
   /// How fast the reference patch follows the face while tracking [0-1].
   double appearance_update_rate = 0.05;
+  /// The locked face's references (shape and patch) are taken again from an
+  /// accepted frame whose |yaw| is this much below theirs: a face locked
+  /// while turned is then still recognised as it turns back to the camera
+  /// (a turned face's far eye and cheek differ most from a frontal one's;
+  /// an occluded frame is never accepted, so never becomes a reference).
+  /// 0 = the references are kept from the lock [rad].
+  double relock_yaw_step_rad = 0.05;
   /// Estimate yaw/pitch/roll with solvePnP.
   bool estimate_head_pose = true;
 };
@@ -136,6 +143,9 @@ class FaceTracker {
                               int* n_scores) const;
   void Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,
               Time stamp, FaceInfo* info);
+  // Takes the references again from an accepted face turned nearer the
+  // camera than they were (options_.relock_yaw_step_rad).
+  void Relock(const Candidate& c, bool acquiring, const cv::Mat& patch, const FaceInfo& info);
   void Fill(const std::vector<Eigen::Vector2d>& landmarks, FaceInfo* info) const;
   bool PredictLandmarks(Time stamp, const OrientationTimeline* timeline,
                         const RowTiming* timing,
@@ -168,6 +178,7 @@ class FaceTracker {
   std::vector<Eigen::Vector2d> last_landmarks_;
   std::vector<Eigen::Vector2d> reference_shape_;  // similarity-normalized
   cv::Mat reference_patch_;                      // CV_32F
+  double reference_yaw_ = 0.0;                   // |yaw| of the references [rad]
   // Box relative to the landmark extent: (dx, dy, sx, sy).
   Eigen::Vector4d box_model_ = Eigen::Vector4d(0.0, -0.1, 1.05, 1.05);
   Time last_seen_;

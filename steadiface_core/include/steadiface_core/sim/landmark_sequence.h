@@ -35,6 +35,9 @@ struct LandmarkSequenceOptions {
   double gyro_noise = 0.0;
   /// Landmark noise [px, per axis].
   double landmark_noise_px = 0.0;
+  /// The head turns about a centre this far behind its eyes [m] (a real
+  /// head's skull; 0: about the eyes).
+  double pivot_depth_m = 0.09;
   /// Frames in [face_lost_from, face_lost_to) have no face observation.
   int face_lost_from = -1, face_lost_to = -1;
   uint64_t seed = 3;
@@ -46,7 +49,8 @@ struct LandmarkFrame {
   /// Noise-free landmarks [normalized] and their rows [px].
   std::vector<Eigen::Vector2d> true_landmarks;
   std::vector<double> true_rows;
-  /// True head centre: mean of the noise-free landmarks [normalized].
+  /// True head centre: the mean of the noise-free landmarks as they would
+  /// be with the head facing forward (pose-invariant) [normalized].
   Eigen::Vector2d true_centre;
   /// True camera-to-world orientation at the middle row.
   Eigen::Quaterniond q_wc_mid;
@@ -76,6 +80,9 @@ class LandmarkSequence {
   std::vector<GyroSample> gyro_;
 
   Eigen::Vector3d Body(double t) const;
+  // A head point (the generic face's frame) in the image at its own row,
+  // turned by the head's pose or facing forward [px].
+  Eigen::Vector2d Project(Time stamp, const Eigen::Vector3d& X_head, bool turned) const;
 };
 
 }  // namespace sim

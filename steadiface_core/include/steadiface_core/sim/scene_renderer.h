@@ -28,7 +28,11 @@ struct Billboard {
   Eigen::Vector2d anchor_px = Eigen::Vector2d::Zero();
   /// Pose at time t [s].
   std::function<Pose(double)> pose;
-  /// Texture point -> world point at time t.
+  /// A relief (CV_32F, one depth per texel along the local z, away from the
+  /// viewer [m]; sim/head_relief.h): the board is then a surface, drawn with
+  /// hidden parts removed. Empty: flat.
+  cv::Mat depth_m;
+  /// Texture point -> world point at time t (on the relief, if any).
   Eigen::Vector3d WorldPoint(const Eigen::Vector2d& uv, double t) const;
 };
 
@@ -40,9 +44,10 @@ Billboard MakeFaceBillboard(const cv::Mat& bgr_photo, const cv::Rect& face_regio
 
 /// Renders a pinhole camera (no distortion) with a rolling shutter: each band
 /// of `band_rows` rows uses the camera pose of its middle row's time
-/// `row_time(y)`. `camera_pose(t)` gives camera-to-world (x right, y down,
-/// z forward) at t. Background at infinity first, then billboards in order
-/// (later ones in front), alpha-blended.
+/// `row_time(y)` (a relief billboard: each texel its own row's).
+/// `camera_pose(t)` gives camera-to-world (x right, y down, z forward) at t.
+/// Background at infinity first, then billboards in order (later ones in
+/// front), alpha-blended.
 void RenderScene(const CameraIntrinsics& k,
                  const std::function<double(double)>& row_time,
                  const std::function<Pose(double)>& camera_pose,

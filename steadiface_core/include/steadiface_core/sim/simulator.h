@@ -11,6 +11,7 @@
 #include "steadiface_core/camera/rolling_shutter.h"
 #include "steadiface_core/common/status.h"
 #include "steadiface_core/gyro/orientation_timeline.h"
+#include "steadiface_core/sim/head_relief.h"
 #include "steadiface_core/sim/motion.h"
 #include "steadiface_core/sim/scene_renderer.h"
 #include "steadiface_core/view/gravity.h"
@@ -84,6 +85,13 @@ struct SimulatorOptions {
   double torso_width_m = 0.42;
   /// Face width on the billboard [m].
   double face_width_m = 0.15;
+  /// The face's shape: "relief" (a head: the photo on an ellipsoid with a
+  /// nose, turning about the skull's centre behind the face, so that its
+  /// landmarks move and hide as a real head's do when it turns) or "flat"
+  /// (the photo on a plane turning about its centre, as before 2026-11-26).
+  std::string head_model = "relief";
+  /// The relief's shape, with head_model "relief".
+  HeadReliefOptions relief;
   /// Hair at the head's top edge: the upper part of the face billboard's
   /// outline becomes strands of varying length, semi-transparent between
   /// them (a soft, ragged edge like real hair).
@@ -138,10 +146,18 @@ struct SimTruth {
   /// True real rotation (world -> camera) at `rotation_rows` rows.
   std::vector<double> rotation_rows;
   std::vector<Eigen::Quaterniond> R_r;
-  /// True head centre in the image [px] (the face photo's landmark centre
-  /// on the billboard, projected at its own row) and whether it is in view.
+  /// True head centre in the image [px], projected at its own row, and
+  /// whether it is in view: where the face photo's landmark centre would be
+  /// if the head faced forward. It moves with the head, not with the head's
+  /// turning and nodding (the paper's pose-invariant head: a stabilizer
+  /// should not follow a head that only turns).
   Eigen::Vector2d head_px = Eigen::Vector2d::Zero();
   bool head_in_view = false;
+  /// The landmark centre as the turned face shows it [px] (on a flat face
+  /// nearly head_px; on a relief it moves sideways as the head turns).
+  Eigen::Vector2d face_px = Eigen::Vector2d::Zero();
+  /// The head's true yaw and pitch against its forward pose [rad].
+  double yaw = 0.0, pitch = 0.0;
   /// Face width in the image [px].
   double face_scale_px = 0.0;
   /// Events active in this frame.
@@ -204,6 +220,10 @@ class Simulator {
   void RenderFrame(int i, bool with_subject, cv::Mat* bgr) const;
   std::vector<const Billboard*> SubjectBoards() const;
   Eigen::Vector3d Body(double t) const;
+  /// The face billboard's pose at t, turned by the head's yaw and pitch
+  /// about the head's turning centre (relief: the skull's centre), or as if
+  /// the head faced forward (turned = false).
+  Pose FacePose(double t, bool turned) const;
   /// Applies the pan orbit (if any) to a world pose.
   Pose Orbit(const Pose& P, double t) const;
   double RowTimeS(Time stamp, double y) const;
@@ -225,6 +245,9 @@ class Simulator {
   void MakeHair();
   void MakePasserBy();
   Eigen::Vector2d face_centre_uv_ = Eigen::Vector2d::Zero();
+  // The head's turning centre in the face billboard's frame [m] (zero: the
+  // billboard's anchor, the flat face).
+  Eigen::Vector3d turning_centre_ = Eigen::Vector3d::Zero();
   std::vector<GyroSample> imu_;
   std::vector<AccelSample> accel_;
 };

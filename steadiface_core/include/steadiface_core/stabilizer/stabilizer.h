@@ -16,6 +16,7 @@
 #include "steadiface_core/gyro/row_rotations.h"
 #include "steadiface_core/stabilizer/dynamic_weights.h"
 #include "steadiface_core/stabilizer/head_smoother.h"
+#include "steadiface_core/stabilizer/pose_invariant_centre.h"
 #include "steadiface_core/stabilizer/stabilizer_options.h"
 #include "steadiface_core/camera/output_geometry.h"
 #include "steadiface_core/warp/protrusion.h"
@@ -297,6 +298,7 @@ class Stabilizer {
   StabilizerOptions options_;
   HeadSmoother smoother_;
   DynamicWeights dynamic_;
+  PoseInvariantCentre pose_centre_;
   StabilizerStats stats_;
 
   // The face-following layer's trajectory (the paper's one virtual camera).

@@ -71,6 +71,19 @@ struct DynamicWeightOptions {
   double pose_min_fit_scale = 0.1;
   /// Smoothness weights are multiplied by (1 + boost) at large head pose [-].
   double pose_smoothness_boost = 3.0;
+  /// The pose-invariant head centre (ours; the paper's §4.4 names the
+  /// problem, "the 2D landmark center is not pose-invariant"): a head turns
+  /// about its skull's centre, this far behind the landmarks' centre, so the
+  /// landmarks are moved back by that depth times sin(yaw) before E_f and
+  /// Eq. 1 read them [face scales: the landmarks' RMS distance to their
+  /// centre]. 0 = off (the paper's landmark centre). The default is what
+  /// removes most of a turning relief head's swing in the simulator (a
+  /// 0.09 m deep turning centre; PnP's yaw reads 0.88 of the true one).
+  double pose_pivot_depth = 1.5;
+  /// Time constant of the causal low-pass on the yaw that moves the
+  /// landmarks: the pose from PnP is noisier from frame to frame than the
+  /// landmarks' centre [s].
+  double pose_yaw_time_constant_s = 0.1;
   /// Frames in the landmark-variation window [count].
   int variation_window = 10;
   /// RMS second difference of the gyro-compensated landmark centre at which

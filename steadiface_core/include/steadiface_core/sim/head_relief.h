@@ -1,0 +1,65 @@
+#pragma once
+
+#include <functional>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "steadiface_core/camera/camera_intrinsics.h"
+#include "steadiface_core/sim/scene_renderer.h"
+
+namespace steadiface {
+namespace sim {
+
+/// The shape given to a face photo so that it turns like a head: a depth per
+/// texel behind the photo's plane.
+struct HeadReliefOptions {
+  /// Depth of the head's turning axis behind the face's plane: the skull's
+  /// centre, about which a head yaws and nods [m].
+  double pivot_depth_m = 0.09;
+  /// The head's outline (the billboard's elliptical mask) reaches the pivot's
+  /// depth at this fraction of the ellipse's radius; beyond it, the mask's
+  /// feathered rim stays at that depth [-].
+  double outline_radius = 0.85;
+  /// The nose: how far its tip stands in front of the face's plane [m], its
+  /// width and length (Gaussian sigmas, as fractions of the face's width)
+  /// and its centre below the landmarks' centre [face widths].
+  double nose_height_m = 0.02;
+  double nose_sigma_x = 0.09, nose_sigma_y = 0.18;
+  double nose_below = 0.08;
+};
+
+/// The depth of a face billboard's texture (`texture_size` texels, the
+/// billboard's `anchor_px` and `metres_per_px`, the landmarks' centre
+/// `face_centre_uv` and the face's width `face_width_px` in texels): an
+/// ellipsoid whose front is the photo's plane and whose outline curves back
+/// to the pivot's depth, plus a nose. CV_32F, metres along the billboard's
+/// local z (away from the viewer; the nose is negative).
+cv::Mat MakeHeadRelief(const cv::Size& texture_size,
+                       const Eigen::Vector2d& face_centre_uv,
+                       double face_width_px, const HeadReliefOptions& options);
+
+/// The relief's depth at texel uv (bilinear; the border's beyond) [m].
+double ReliefDepth(const cv::Mat& depth, const Eigen::Vector2d& uv);
+
+/// Renders a billboard with a relief (b.depth_m) as RenderBoard renders a
+/// flat one: into `layer` (BGRA, alpha 0 where it is not), with a rolling
+/// shutter (each texel seen at its own row's time, the poses taken per band
+/// of `band` rows), hidden surfaces removed (a depth buffer) and the faces
+/// turned away from the camera culled. The texture is a grid of triangles
+/// every `grid_texels`, each drawn with its texels interpolated bilinearly.
+void RenderRelief(const CameraIntrinsics& k,
+                  const std::function<double(double)>& row_time,
+                  const std::function<Pose(double)>& camera_pose,
+                  const Billboard& b, int band, cv::Mat* layer,
+                  int grid_texels = 2);
+
+/// Where a camera ray first meets a relief billboard: the texel uv, or false
+/// when it misses the texture. `origin` and `ray` in the world, `P` the
+/// billboard's pose.
+bool IntersectRelief(const Billboard& b, const Pose& P,
+                     const Eigen::Vector3d& origin, const Eigen::Vector3d& ray,
+                     Eigen::Vector2d* uv);
+
+}  // namespace sim
+}  // namespace steadiface
