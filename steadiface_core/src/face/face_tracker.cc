@@ -107,10 +107,11 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
 void FaceTracker::Relock(const Candidate& c, bool acquiring, const cv::Mat& patch,
                          const FaceInfo& info) {
   // The references follow the face towards the camera (never away from it).
-  if (!info.has_pose || !std::isfinite(info.yaw)) return;
+  // A lock without a pose counts as frontal: it is never re-taken.
+  const bool posed = info.has_pose && std::isfinite(info.yaw);
   if (acquiring) {
-    reference_yaw_ = std::abs(info.yaw);
-  } else if (options_.relock_yaw_step_rad > 0.0 &&
+    reference_yaw_ = posed ? std::abs(info.yaw) : 0.0;
+  } else if (posed && options_.relock_yaw_step_rad > 0.0 &&
              std::abs(info.yaw) < reference_yaw_ - options_.relock_yaw_step_rad) {
     reference_shape_ = Normalize(c.landmarks);
     if (!patch.empty()) reference_patch_ = patch.clone();
