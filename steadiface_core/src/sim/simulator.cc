@@ -290,10 +290,11 @@ Status Simulator::Init() {
   const double m_per_px = o.face_width_m / o.face_width_px;
   face_ = MakeFaceBillboard(photo, o.face_region, o.face_region.width * m_per_px);
   face_centre_uv_ = o.face_centre_px - Eigen::Vector2d(o.face_region.x, o.face_region.y);
+  const Eigen::Vector2d centre = (face_centre_uv_ - face_.anchor_px) * face_.metres_per_px;
+  face_front_ = Eigen::Vector3d(centre.x(), centre.y(), 0.0);
   if (o.head_model == "relief") {
     face_.depth_m = MakeHeadRelief(face_.bgra.size(), face_centre_uv_, o.face_width_px, o.relief);
-    const Eigen::Vector2d c = (face_centre_uv_ - face_.anchor_px) * face_.metres_per_px;
-    turning_centre_ = Eigen::Vector3d(c.x(), c.y(), o.relief.pivot_depth_m);
+    turning_centre_ = face_front_ + Eigen::Vector3d(0.0, 0.0, o.relief.pivot_depth_m);
   }
   face_.pose = [this](double t) { return FacePose(t, true); };
   if (o.hair_edge) MakeHair();
@@ -396,22 +397,6 @@ double Simulator::RealGyroTime(double t, double* sign) const {
   return u;
 }
 
-Pose Simulator::FacePose(double t, bool turned) const {
-  Pose P;
-  if (turned) P.R = head_.Orientation(t);
-  // Turned about the turning centre: it stays where it is unturned.
-  P.p = head_.Position(t) + Body(t) + turning_centre_ - P.R * turning_centre_;
-  P = Orbit(P, t);
-  const SimulatorOptions& so = options_;
-  if (so.face_out_start_s >= 0) {
-    // Sideways out of view and back.
-    const double out = Ramp(t, so.face_out_start_s, so.face_out_start_s + 0.4) -
-                       Ramp(t, so.face_out_end_s, so.face_out_end_s + 0.4);
-    P.p.x() += 0.6 * out;
-  }
-  return P;
-}
-
 Pose Simulator::Orbit(const Pose& P, double t) const {
   if (!options_.pan_orbits_head || options_.camera.pan_rate == 0.0) return P;
   const Eigen::Quaterniond R_pan(
@@ -459,17 +444,15 @@ SimTruth Simulator::Truth(int i) const {
   }
   auto row_time = [&](double y) { return RowTimeS(tr.stamp, y); };
   auto cam = [this](double t) { return CameraPose(t); };
-  const Eigen::Vector2d centre = (face_centre_uv_ - face_.anchor_px) * face_.metres_per_px;
-  const Eigen::Vector3d front(centre.x(), centre.y(), 0.0);
   const bool visible = ProjectRollingShutter(k, row_time, cam, [&](double t) {
     const Pose P = FacePose(t, false);
-    return Eigen::Vector3d(P.R * front + P.p);
+    return Eigen::Vector3d(P.R * face_front_ + P.p);
   }, &tr.head_px);
   tr.head_in_view = options_.render_face && visible && tr.head_px.x() >= 0 && tr.head_px.y() >= 0 &&
                     tr.head_px.x() <= k.width - 1 && tr.head_px.y() <= k.height - 1;
   ProjectRollingShutter(k, row_time, cam, [&](double t) {
     const Pose P = FacePose(t, true);
-    return Eigen::Vector3d(P.R * front + P.p);
+    return Eigen::Vector3d(P.R * face_front_ + P.p);
   }, &tr.face_px);
   Eigen::Vector2d a, b;
   const double half = 0.5 * options_.face_width_px;
@@ -481,8 +464,9 @@ SimTruth Simulator::Truth(int i) const {
       }, &b)) {
     tr.face_scale_px = (b - a).norm();
   }
-  tr.yaw = head_.Yaw(ToSeconds(timing_.RowTime(tr.stamp, 0.5 * (k.height - 1))));
-  tr.pitch = head_.Pitch(ToSeconds(timing_.RowTime(tr.stamp, 0.5 * (k.height - 1))));
+  const double t_mid = RowTimeS(tr.stamp, 0.5 * (k.height - 1));
+  tr.yaw = head_.Yaw(t_mid);
+  tr.pitch = head_.Pitch(t_mid);
   const double t = ToSeconds(tr.stamp);
   const SimulatorOptions& o = options_;
   tr.occluded = Active(t, o.occlusion_start_s + 0.3 * (o.occlusion_end_s - o.occlusion_start_s),

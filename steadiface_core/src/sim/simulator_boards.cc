@@ -1,5 +1,6 @@
-// The simulator's billboards besides the face: the torso, the hair edge,
-// the passer-by, the second face and the occluding hand.
+// The simulator's billboards: the face's pose, and the billboards besides
+// the face: the torso, the hair edge, the passer-by, the second face and
+// the occluding hand.
 #include <algorithm>
 #include <cmath>
 
@@ -10,6 +11,22 @@
 
 namespace steadiface {
 namespace sim {
+
+Pose Simulator::FacePose(double t, bool turned) const {
+  Pose P;
+  if (turned) P.R = head_.Orientation(t);
+  // Turned about the turning centre: it stays where it is unturned.
+  P.p = head_.Position(t) + Body(t) + turning_centre_ - P.R * turning_centre_;
+  P = Orbit(P, t);
+  const SimulatorOptions& so = options_;
+  if (so.face_out_start_s >= 0) {
+    // Sideways out of view and back.
+    const double out = Ramp(t, so.face_out_start_s, so.face_out_start_s + 0.4) -
+                       Ramp(t, so.face_out_end_s, so.face_out_end_s + 0.4);
+    P.p.x() += 0.6 * out;
+  }
+  return P;
+}
 
 void Simulator::MakeTorso() {
   const SimulatorOptions& o = options_;
@@ -39,9 +56,7 @@ void Simulator::MakeTorso() {
   torso_.pose = [this](double t) {
     // The face billboard's position without its turning and nodding.
     const Pose P = FacePose(t, false);
-    const Eigen::Vector3d centre = P.p + P.R * Eigen::Vector3d(
-        (face_centre_uv_.x() - face_.anchor_px.x()) * face_.metres_per_px,
-        (face_centre_uv_.y() - face_.anchor_px.y()) * face_.metres_per_px, 0.0);
+    const Eigen::Vector3d centre = P.p + P.R * face_front_;
     Pose T;
     T.R = Orbit(Pose(), t).R;
     T.p = centre + T.R * Eigen::Vector3d(0.0, 0.08, options_.torso_depth_m);

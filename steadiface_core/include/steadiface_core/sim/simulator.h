@@ -245,6 +245,8 @@ class Simulator {
   void MakeHair();
   void MakePasserBy();
   Eigen::Vector2d face_centre_uv_ = Eigen::Vector2d::Zero();
+  // The same centre in the face billboard's frame, on its plane [m].
+  Eigen::Vector3d face_front_ = Eigen::Vector3d::Zero();
   // The head's turning centre in the face billboard's frame [m] (zero: the
   // billboard's anchor, the flat face).
   Eigen::Vector3d turning_centre_ = Eigen::Vector3d::Zero();
