@@ -348,6 +348,7 @@ steadiface::FaceLandmarks ToMsg(const steadiface::FaceInfo& f, const std_msgs::H
                                                               : steadiface::FaceLandmarks::SEARCHING;
   m.failure = steadiface::FaceFailureName(f.failure);
   m.valid = f.valid;
+  m.followed = f.followed;
   m.confidence = static_cast<float>(f.confidence);
   m.box_x = static_cast<float>(f.box.x);
   m.box_y = static_cast<float>(f.box.y);

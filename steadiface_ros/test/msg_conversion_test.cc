@@ -35,6 +35,32 @@ TEST(MsgConversionTest, CameraInfoToIntrinsics) {
   EXPECT_FALSE(k.HasDistortion());
 }
 
+TEST(MsgConversionTest, AFollowedFaceIsPublishedAsFollowedNotValid) {
+  steadiface::FaceInfo f;
+  f.state = steadiface::TrackingState::kLost;
+  f.failure = steadiface::FaceFailure::kImplausibleShape;
+  f.followed = true;
+  f.landmarks_px = {Eigen::Vector2d(10.0, 20.0), Eigen::Vector2d(30.0, 40.0)};
+  f.centre_px = Eigen::Vector2d(20.0, 30.0);
+  f.has_pose = true;
+  f.yaw = 1.1;
+  std_msgs::Header h;
+  h.frame_id = "camera";
+  const steadiface::FaceLandmarks m = ToMsg(f, h);
+  EXPECT_FALSE(m.valid);
+  EXPECT_TRUE(m.followed);
+  EXPECT_EQ(m.state, steadiface::FaceLandmarks::LOST);
+  EXPECT_EQ(m.failure, "implausible_shape");
+  ASSERT_EQ(m.points.size(), 2u);
+  EXPECT_DOUBLE_EQ(m.points[1].y, 40.0);
+  EXPECT_DOUBLE_EQ(m.centre.x, 20.0);
+  EXPECT_FLOAT_EQ(m.yaw, 1.1f);
+  EXPECT_TRUE(f.located());
+  f.followed = false;
+  EXPECT_FALSE(ToMsg(f, h).followed);
+  EXPECT_FALSE(f.located());
+}
+
 TEST(MsgConversionTest, DistortionModels) {
   steadiface::CameraIntrinsics k;
   sensor_msgs::CameraInfo info = MakeInfo();

@@ -20,6 +20,11 @@ namespace steadiface {
 
 using namespace face_internal;  // NOLINT: the tracker's own helpers
 
+namespace {
+// Follow's gate forgets a turn at this rate [rad/s].
+constexpr double kTurnMemoryRadPerS = 0.3;
+}  // namespace
+
 Status FaceTracker::Create(const CameraModel& model,
                            const FaceTrackerOptions& options,
                            std::unique_ptr<FaceTracker>* out) {
@@ -52,6 +57,11 @@ void FaceTracker::Reset() {
   reference_shape_.clear();
   reference_patch_.release();
   reference_yaw_ = 0.0;
+  region_motion_.Clear();
+  following_ = false;
+  fitted_last_frame_ = false;
+  have_fitted_pose_ = false;
+  recent_abs_yaw_ = 0.0;
   have_last_rotation_ = false;
   frames_since_detect_ = 0;
   frames_tracked_ = 0;
@@ -60,6 +70,9 @@ void FaceTracker::Reset() {
 
 void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,
                          Time stamp, FaceInfo* info) {
+  const bool after_fit = fitted_last_frame_;
+  const Time previous_fit = last_seen_;
+  fitted_last_frame_ = true;
   if (acquiring) {
     reference_shape_ = Normalize(c.landmarks);
     reference_patch_ = patch.empty() ? cv::Mat() : patch.clone();
@@ -79,7 +92,10 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
     }
   }
   last_landmarks_ = c.landmarks;
+  fitted_landmarks_ = c.landmarks;
+  following_ = false;
   last_seen_ = stamp;
+  last_located_ = stamp;
   state_ = TrackingState::kTracking;
   force_detect_ = false;
   ++frames_tracked_;
@@ -101,6 +117,22 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
     info->has_pose = EstimateHeadPose(head_model_, ideal, pinhole, &info->yaw, &info->pitch, &info->roll);
     info->timings.pose_ms = MsSince(t0);
   }
+  const bool posed = info->has_pose && std::isfinite(info->yaw);
+  // The turn's rate over consecutive fits, for a turn followed on
+  // (face/head_turn.h filters it the same way).
+  const bool consecutive = posed && have_fitted_pose_ && !acquiring && after_fit;
+  fitted_yaw_rate_ =
+      consecutive ? fitted_yaw_rate_ + kHeadTurnRateGain * (info->yaw - fitted_yaw_ - fitted_yaw_rate_)
+                  : 0.0;
+  // How far the face turned lately: the largest fitted |yaw|, forgotten at
+  // kTurnMemoryRadPerS (PnP's yaw is noisy frame to frame).
+  const double dt = acquiring ? 1e9 : std::max(0.0, ToSeconds(stamp - previous_fit));
+  recent_abs_yaw_ = std::max(posed ? std::abs(info->yaw) : 0.0,
+                             recent_abs_yaw_ - kTurnMemoryRadPerS * std::min(dt, 10.0));
+  have_fitted_pose_ = posed;
+  fitted_yaw_ = info->yaw;
+  fitted_pitch_ = info->pitch;
+  fitted_roll_ = info->roll;
   Relock(c, acquiring, patch, *info);
 }
 
@@ -120,6 +152,7 @@ void FaceTracker::Relock(const Candidate& c, bool acquiring, const cv::Mat& patc
 }
 
 void FaceTracker::MarkFailure(FaceFailure f, Time stamp, FaceInfo* info) {
+  fitted_last_frame_ = false;
   if (state_ == TrackingState::kTracking) state_ = TrackingState::kLost;
   force_detect_ = true;
   info->state = state_;
@@ -209,7 +242,7 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
   const cv::Rect full(0, 0, gray.cols, gray.rows);
 
   if (state_ == TrackingState::kLost &&
-      ToSeconds(stamp - last_seen_) > options_.lost_timeout_s) {
+      ToSeconds(stamp - last_located_) > options_.lost_timeout_s) {
     Reset();
   }
   // While searching, the whole frame once per search_interval_s and a
@@ -262,6 +295,7 @@ void FaceTracker::Search(const cv::Mat& gray, const SearchStep& step, Time stamp
   }
   if (ok) {
     Accept(c, true, patch, stamp, info);
+    region_motion_.Remember(gray, BoxFromLandmarks(c.landmarks));
   } else {
     MarkFailure(faces.empty() ? FaceFailure::kNoFace : info->failure, stamp, info);
   }
@@ -329,13 +363,76 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
   }
   if (ok) {
     Accept(c, false, patch, stamp, info);
-  } else {
-    MarkFailure(info->failure == FaceFailure::kNone ? FaceFailure::kNoFace : info->failure,
-                stamp, info);
-    // Keep following the lost face with the gyro, so re-detection looks
-    // where it should be.
-    if (rot_ok) last_landmarks_ = predicted;
+    region_motion_.Remember(gray, BoxFromLandmarks(c.landmarks));
+    return;
   }
+  MarkFailure(info->failure == FaceFailure::kNone ? FaceFailure::kNoFace : info->failure,
+              stamp, info);
+  if (Follow(gray, stamp, pc, info)) return;
+  region_motion_.Clear();
+  // Keep following the lost face with the gyro, so re-detection looks
+  // where it should be.
+  if (rot_ok) last_landmarks_ = predicted;
+}
+
+bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d& pc,
+                         FaceInfo* info) {
+  // A face last fitted turned away whose landmarks now fail has most
+  // likely turned past what the landmark model fits; its head is still in
+  // view, and is followed as a turning cylinder (face/head_turn.h) within
+  // the gyro gate. A face lost while facing the camera (a hand, someone
+  // passing) is not followed, so the tracker never follows what covers it.
+  if (!(options_.follow_turned_s > 0.0) || !have_fitted_pose_ || !region_motion_.ready() ||
+      recent_abs_yaw_ < options_.follow_min_yaw_rad || fitted_landmarks_.empty() ||
+      ToSeconds(stamp - last_seen_) > options_.follow_turned_s) {
+    following_ = false;
+    return false;
+  }
+  const Eigen::Vector2d fitted_centre = Mean(fitted_landmarks_);
+  const double scale = RmsRadius(fitted_landmarks_, fitted_centre);
+  if (!following_) {
+    // The axis from the last fit: behind the landmark centre by the pivot.
+    head_turn_ = HeadTurn();
+    head_turn_.radius_px = options_.head_pivot_depth * scale;
+    head_turn_.yaw = options_.head_pivot_depth > 0.0 ? fitted_yaw_ : 0.0;
+    head_turn_.yaw_rate = options_.head_pivot_depth > 0.0 ? fitted_yaw_rate_ : 0.0;
+    head_turn_.axis_px =
+        Mean(last_landmarks_) + Eigen::Vector2d(head_turn_.radius_px * std::sin(head_turn_.yaw), 0);
+  }
+  RegionFlow flow;
+  HeadTurn next = head_turn_;
+  const bool moved = region_motion_.Track(gray, &flow) &&
+                     (next.radius_px > 0.0 ? UpdateHeadTurn(flow, &next)
+                                           : (next.axis_px += flow.mean_shift, true));
+  const Eigen::Vector2d centre = next.FaceCentre();
+  if (!moved || !(scale > 0.0) || (centre - pc).norm() > options_.max_jump * scale) {
+    following_ = false;
+    return false;
+  }
+  std::vector<Eigen::Vector2d> lm = fitted_landmarks_;
+  for (auto& p : lm) p += centre - fitted_centre;
+  // The region followed next: the head about its axis, the face's rows.
+  const cv::Rect2d face = BoxFromLandmarks(lm);
+  const double half = next.radius_px > 0.0 ? 0.9 * next.radius_px : 0.5 * face.width;
+  const cv::Rect2d head(next.axis_px.x() - half, face.y, 2.0 * half, face.height);
+  if ((head & cv::Rect2d(0, 0, gray.cols, gray.rows)).area() < 0.5 * head.area()) {
+    following_ = false;
+    return false;
+  }
+  following_ = true;
+  head_turn_ = next;
+  last_landmarks_ = lm;
+  last_located_ = stamp;
+  region_motion_.Remember(gray, head);
+  info->followed = true;
+  info->box = face;
+  Fill(lm, info);
+  info->confidence = flow.inlier_share;
+  info->has_pose = true;
+  info->yaw = head_turn_.yaw;
+  info->pitch = fitted_pitch_;
+  info->roll = fitted_roll_;
+  return true;
 }
 
 Status FaceTracker::ProcessExternal(const std::vector<Eigen::Vector2d>& lm,
@@ -351,7 +448,7 @@ Status FaceTracker::ProcessExternal(const std::vector<Eigen::Vector2d>& lm,
                          std::to_string(lm.size()));
   }
   if (state_ == TrackingState::kLost &&
-      ToSeconds(stamp - last_seen_) > options_.lost_timeout_s) {
+      ToSeconds(stamp - last_located_) > options_.lost_timeout_s) {
     Reset();
   }
   bool rot_ok = false;

@@ -40,6 +40,22 @@ Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
     err << "face.appearance_patch_px must be in [16, 256], got " << o.appearance_patch_px;
   } else if (!(o.relock_yaw_step_rad >= 0.0 && o.relock_yaw_step_rad <= 1.0)) {
     err << "face.relock_yaw_step_rad must be in [0, 1], got " << o.relock_yaw_step_rad;
+  } else if (!(o.follow_turned_s >= 0.0 && o.follow_turned_s <= 60.0)) {
+    err << "face.follow_turned must be in [0, 60] s, got " << o.follow_turned_s;
+  } else if (!(o.follow_min_yaw_rad >= 0.0 && o.follow_min_yaw_rad <= 1.6)) {
+    err << "face.follow_min_yaw must be in [0, 1.6] rad, got " << o.follow_min_yaw_rad;
+  } else if (!(o.head_pivot_depth >= 0.0 && o.head_pivot_depth <= 10.0)) {
+    err << "face.head_pivot_depth must be in [0, 10] face scales, got " << o.head_pivot_depth;
+  } else if (o.region_motion.max_features < 4 || o.region_motion.max_features > 1000 ||
+             o.region_motion.min_inliers < 3 ||
+             o.region_motion.min_inliers > o.region_motion.max_features) {
+    err << "face.region_motion: need 3 <= min_inliers <= max_features <= 1000, got "
+        << o.region_motion.min_inliers << " / " << o.region_motion.max_features;
+  } else if (!(o.region_motion.max_forward_backward_px > 0.0) ||
+             !(o.region_motion.inlier_share > 0.0) ||
+             !(o.region_motion.search_margin >= 0.1 && o.region_motion.search_margin <= 3.0)) {
+    err << "face.region_motion: max_forward_backward_px and inlier_share must be > 0, "
+           "search_margin in [0.1, 3]";
   } else if (!(o.appearance_update_rate >= 0.0 && o.appearance_update_rate <= 1.0)) {
     err << "face.appearance_update_rate must be in [0, 1], got "
         << o.appearance_update_rate;

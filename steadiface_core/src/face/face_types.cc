@@ -42,8 +42,8 @@ const char* FaceFailureName(FaceFailure f) {
 
 FaceObservation FaceInfo::ToObservation() const {
   FaceObservation o;
-  o.valid = valid;
-  if (!valid) return o;
+  o.valid = located();
+  if (!o.valid) return o;
   o.landmarks = landmarks_normalized;
   o.landmark_rows.reserve(landmarks_px.size());
   for (const auto& p : landmarks_px) o.landmark_rows.push_back(p.y());

@@ -101,6 +101,9 @@ Status Pipeline::Create(const CameraIntrinsics& intrinsics,
     // face-of-interest logic (no model file needed for them, but the
     // tracker loads it; a missing file is an error only for kDlib).
     FaceTrackerOptions fo = options.face;
+    // A head followed through a turn turns about the pose-invariant
+    // centre's pivot (one model for both).
+    fo.head_pivot_depth = options.stabilizer.dynamic.pose_pivot_depth;
     s = FaceTracker::Create(model, fo, &p->tracker_);
     if (!s.ok()) return s;
   }
@@ -202,7 +205,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   f.timings.face_ms = MsSince(t_face);
   // The visual source leaves the subject out: the face found, or the lost
   // one where it was last seen, until the tracker searches again.
-  if (f.face.valid) {
+  if (f.face.located()) {
     last_face_box_ = f.face.box;
   } else if (f.face.state == TrackingState::kSearching) {
     last_face_box_ = cv::Rect2d();
@@ -210,7 +213,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   // The gyro-vs-video check (never changes the pose), outside the face.
   if (check_ != nullptr) {
     const auto t_check = std::chrono::steady_clock::now();
-    check_->Process(grey, stamp, timeline_, f.face.valid ? f.face.box : cv::Rect2d());
+    check_->Process(grey, stamp, timeline_, f.face.located() ? f.face.box : cv::Rect2d());
     f.gyro_video_check = check_->result();
     f.timings.check_ms = MsSince(t_check);
   }
@@ -266,7 +269,7 @@ const FaceObservation* Pipeline::FaceStep(const cv::Mat& image, Time stamp,
       s = tracker_->Process(grey, stamp, &timeline_, &timing_, &f->face);
     }
     // A face error never stops stabilization: it is a frame without a face.
-    if (f->face.valid) {
+    if (f->face.located()) {
       *observation = f->face.ToObservation();
       obs = observation;
     }

@@ -13,6 +13,8 @@
 #include "steadiface_core/common/time.h"
 #include "steadiface_core/face/face_detector.h"
 #include "steadiface_core/face/face_types.h"
+#include "steadiface_core/face/head_region_motion.h"
+#include "steadiface_core/face/head_turn.h"
 #include "steadiface_core/face/landmark_predictor.h"
 #include "steadiface_core/face/search_schedule.h"
 #include "steadiface_core/gyro/orientation_timeline.h"
@@ -75,6 +77,25 @@ struct FaceTrackerOptions {
   /// an occluded frame is never accepted, so never becomes a reference).
   /// 0 = the references are kept from the lock [rad].
   double relock_yaw_step_rad = 0.05;
+  /// A locked face whose landmarks are given up after it was last seen
+  /// turned by at least follow_min_yaw_rad is still a head in view, turned
+  /// past what the landmark model fits: its last landmarks are carried by
+  /// the head region's image motion (HeadRegionMotion) for at most this
+  /// long after the last fit, and the stabilizer keeps holding the head;
+  /// 0 = off [s].
+  double follow_turned_s = 3.0;
+  /// ... from this |yaw| of the fitted landmarks: the largest over the
+  /// last fits, forgotten at 0.3 rad/s (a face lost while facing the camera
+  /// is covered or gone, and is held, not followed) [rad].
+  double follow_min_yaw_rad = 0.3;
+  /// How the head region's motion is measured.
+  HeadRegionMotionOptions region_motion;
+  /// The followed head turns about an axis this far behind its landmarks,
+  /// in face scales (RMS landmark radius) (face/head_turn.h). The pipeline
+  /// sets it to the stabilizer's dynamic.pose_pivot_depth, so the followed
+  /// head and the pose-invariant centre share one model; 0: the head is
+  /// followed by its translation only [-].
+  double head_pivot_depth = 1.5;
   /// Estimate yaw/pitch/roll with solvePnP.
   bool estimate_head_pose = true;
 };
@@ -146,6 +167,10 @@ class FaceTracker {
   // Takes the references again from an accepted face turned nearer the
   // camera than they were (options_.relock_yaw_step_rad).
   void Relock(const Candidate& c, bool acquiring, const cv::Mat& patch, const FaceInfo& info);
+  // A turned face whose landmarks failed: its last landmarks moved with
+  // the head region (options_.follow_turned_s); false when not followed.
+  bool Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d& predicted_centre,
+              FaceInfo* info);
   void Fill(const std::vector<Eigen::Vector2d>& landmarks, FaceInfo* info) const;
   bool PredictLandmarks(Time stamp, const OrientationTimeline* timeline,
                         const RowTiming* timing,
@@ -179,6 +204,16 @@ class FaceTracker {
   std::vector<Eigen::Vector2d> reference_shape_;  // similarity-normalized
   cv::Mat reference_patch_;                      // CV_32F
   double reference_yaw_ = 0.0;                   // |yaw| of the references [rad]
+  HeadRegionMotion region_motion_;               // the head's crop, for Follow
+  bool following_ = false;                       // Follow's state:
+  HeadTurn head_turn_;                           // the followed head
+  std::vector<Eigen::Vector2d> fitted_landmarks_;  // the last fit's
+  bool have_fitted_pose_ = false;                // the last fit's pose:
+  double fitted_yaw_ = 0.0, fitted_pitch_ = 0.0, fitted_roll_ = 0.0;  // [rad]
+  double fitted_yaw_rate_ = 0.0;                 // over consecutive fits [rad/frame]
+  bool fitted_last_frame_ = false;
+  double recent_abs_yaw_ = 0.0;                  // the turn lately, for Follow [rad]
+  Time last_located_;                            // last fitted or followed
   // Box relative to the landmark extent: (dx, dy, sx, sy).
   Eigen::Vector4d box_model_ = Eigen::Vector4d(0.0, -0.1, 1.05, 1.05);
   Time last_seen_;

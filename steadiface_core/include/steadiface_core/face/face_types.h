@@ -57,6 +57,11 @@ struct FaceInfo {
   FaceFailure failure = FaceFailure::kNone;
   /// True when `landmarks_*` hold this frame's validated landmarks.
   bool valid = false;
+  /// True when the landmarks failed (`failure` says why) but the head,
+  /// last seen turned away, was followed by its image motion: `landmarks_*`
+  /// hold the last fitted landmarks moved with it, a position and not a
+  /// fit, and the pose is the last fit's (FaceTrackerOptions::follow_turned_s).
+  bool followed = false;
   /// Detection ran this frame (acquisition, periodic or after a failure).
   bool detected = false;
   /// Box the landmarks were fitted in [px].
@@ -86,7 +91,9 @@ struct FaceInfo {
   double lost_for_s = 0.0;
   FaceTimings timings;
 
-  /// What the stabilizer consumes.
+  /// Where the face is known this frame: fitted or followed.
+  bool located() const { return valid || followed; }
+  /// What the stabilizer consumes (valid when located()).
   FaceObservation ToObservation() const;
 };
 

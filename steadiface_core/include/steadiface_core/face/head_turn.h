@@ -1,0 +1,49 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "steadiface_core/face/head_region_motion.h"
+
+namespace steadiface {
+
+/// The gain of the first-order filter on the yaw's rate per frame: one
+/// frame's flow measures the turn with an error about as large as the turn
+/// itself (rolling shutter, pitch, a few dozen tracks), so the rate follows
+/// the measurements over about three frames and the yaw does not
+/// random-walk over a turn of two seconds [-].
+constexpr double kHeadTurnRateGain = 0.35;
+
+/// A head followed through a turn past what the landmark model fits, as a
+/// vertical cylinder about its turning axis: the cylinder head model
+/// (La Cascia, Sclaroff and Athitsos 2000; Xiao, Kanade and Cohn 2002)
+/// reduced to the motions that matter to the stabilizer, the axis' image
+/// translation and the yaw about it. A surface point at angle beta from the
+/// line of sight sits at x = axis.x + r sin(beta), depth z = r cos(beta)
+/// towards the camera; a turn by d_yaw moves it by dx = -z d_yaw. So points
+/// near the silhouette (z ~ 0) move with the axis and points facing the
+/// camera with the turn, and one frame's flow gives both.
+struct HeadTurn {
+  /// x: the turning axis in the image; y: the face centre's row [px].
+  Eigen::Vector2d axis_px = Eigen::Vector2d::Zero();
+  /// The yaw, in the landmarks' convention: the face centre sits at
+  /// axis.x - radius sin(yaw) [rad].
+  double yaw = 0.0;
+  /// The yaw's change per frame, filtered [rad/frame].
+  double yaw_rate = 0.0;
+  /// The face's distance from the axis in the image [px].
+  double radius_px = 0.0;
+
+  /// Where the landmark centre is while the head is turned so [px].
+  Eigen::Vector2d FaceCentre() const;
+};
+
+/// One frame: the axis moves by the flow's part common to all depths and
+/// the yaw by its part proportional to depth (least squares over the
+/// tracks). When the tracks' depths do not spread (they all face the
+/// camera, or all sit at the silhouette) the turn is not observable and
+/// only the translation is taken. The yaw stays within +-1.5 rad and
+/// changes at most 0.15 rad per frame; its rate is filtered (kHeadTurnRateGain). False (state kept) with fewer than 3
+/// tracks or a radius <= 0.
+bool UpdateHeadTurn(const RegionFlow& flow, HeadTurn* head);
+
+}  // namespace steadiface

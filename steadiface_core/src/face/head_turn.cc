@@ -1,0 +1,64 @@
+// The turned head's axis and yaw from its region's flow (face/head_turn.h).
+#include "steadiface_core/face/head_turn.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace steadiface {
+
+Eigen::Vector2d HeadTurn::FaceCentre() const {
+  return Eigen::Vector2d(axis_px.x() - radius_px * std::sin(yaw), axis_px.y());
+}
+
+bool UpdateHeadTurn(const RegionFlow& flow, HeadTurn* head) {
+  const size_t all = std::min(flow.from.size(), flow.shift.size());
+  const double r = head->radius_px;
+  if (!(r > 0.0)) return false;
+  // The tracks on the cylinder (within 0.9 radii of the axis: the rest may
+  // be background beside the head), and each one's depth towards the
+  // camera from its offset to the axis.
+  std::vector<double> z, dx;
+  double dy_mean = 0.0;
+  for (size_t i = 0; i < all; ++i) {
+    const double s = std::abs(flow.from[i].x() - head->axis_px.x()) / r;
+    if (s > 0.9) continue;
+    z.push_back(r * std::sqrt(1.0 - s * s));
+    dx.push_back(flow.shift[i].x());
+    dy_mean += flow.shift[i].y();
+  }
+  const size_t n = z.size();
+  if (n < 3) return false;
+  double z_mean = 0.0, dx_mean = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    z_mean += z[i];
+    dx_mean += dx[i];
+  }
+  z_mean /= n;
+  dx_mean /= n;
+  dy_mean /= n;
+  double var = 0.0, cov = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    var += (z[i] - z_mean) * (z[i] - z_mean);
+    cov += (z[i] - z_mean) * (dx[i] - dx_mean);
+  }
+  var /= n;
+  cov /= n;
+  // dx = d_axis - z d_yaw; the depths must spread by a twentieth of the radius.
+  // The rate follows one frame's measured turn through a first-order filter
+  // (kHeadTurnRateGain); unobservable, it decays.
+  if (var > (0.05 * r) * (0.05 * r)) {
+    const double measured = std::max(-0.15, std::min(0.15, -cov / var));
+    head->yaw_rate += kHeadTurnRateGain * (measured - head->yaw_rate);
+  } else {
+    head->yaw_rate *= 1.0 - kHeadTurnRateGain;
+  }
+  const double d_yaw = head->yaw_rate;
+  const double d_axis = dx_mean + d_yaw * z_mean;
+  if (!std::isfinite(d_axis) || !std::isfinite(dy_mean)) return false;
+  head->axis_px += Eigen::Vector2d(d_axis, dy_mean);
+  head->yaw = std::max(-1.5, std::min(1.5, head->yaw + d_yaw));
+  return true;
+}
+
+}  // namespace steadiface

@@ -1,0 +1,141 @@
+// Following a head turned past what the landmark model fits: the region's
+// image motion from sparse tracks (HeadRegionMotion) on a texture moved by
+// a known shift, and the turning cylinder (HeadTurn) on the exact motion of
+// points on a cylinder whose axis moves and which turns at known rates.
+#include <cmath>
+#include <iostream>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "steadiface_core/face/head_region_motion.h"
+#include "steadiface_core/face/head_turn.h"
+
+namespace steadiface {
+namespace {
+
+cv::Mat Texture(const cv::Size& size, unsigned seed) {
+  cv::Mat noise(size, CV_8U);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.0);
+  cv::normalize(noise, noise, 0, 255, cv::NORM_MINMAX);
+  return noise;
+}
+
+TEST(HeadRegionMotionTest, MeasuresAKnownSubPixelShiftAndForgetsOnClear) {
+  const cv::Mat a = Texture(cv::Size(320, 240), 7);
+  const cv::Mat M = (cv::Mat_<double>(2, 3) << 1, 0, 3.25, 0, 1, -2.5);
+  cv::Mat b;
+  cv::warpAffine(a, b, M, a.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  HeadRegionMotion motion;
+  EXPECT_FALSE(motion.ready());
+  RegionFlow flow;
+  EXPECT_FALSE(motion.Track(b, &flow));  // nothing remembered
+  motion.Remember(a, cv::Rect2d(110, 70, 100, 110));
+  ASSERT_TRUE(motion.ready());
+  ASSERT_TRUE(motion.Track(b, &flow));
+  EXPECT_NEAR(flow.mean_shift.x(), 3.25, 0.1);
+  EXPECT_NEAR(flow.mean_shift.y(), -2.5, 0.1);
+  EXPECT_GE(static_cast<int>(flow.shift.size()), HeadRegionMotionOptions().min_inliers);
+  EXPECT_GT(flow.inlier_share, 0.9);
+  // Every track starts inside the region's ellipse's box.
+  for (const auto& p : flow.from) {
+    EXPECT_GE(p.x(), 109.0);
+    EXPECT_LE(p.x(), 211.0);
+  }
+  motion.Clear();
+  EXPECT_FALSE(motion.Track(b, &flow));
+}
+
+TEST(HeadRegionMotionTest, AFlatRegionGivesNoMeasurement) {
+  const cv::Mat flat(240, 320, CV_8U, cv::Scalar(128));
+  HeadRegionMotion motion;
+  motion.Remember(flat, cv::Rect2d(110, 70, 100, 110));
+  RegionFlow flow;
+  EXPECT_FALSE(motion.Track(flat, &flow));
+}
+
+// Points on a cylinder of radius r about the axis at x = a: a point at
+// angle beta from the line of sight is at x = a + r sin(beta). The face
+// centre is at beta = -yaw. A turn by d lowers every beta by d.
+RegionFlow CylinderFlow(double a, double r, double da, double dy, double d_yaw,
+                        const std::vector<double>& betas) {
+  RegionFlow f;
+  for (double b : betas) {
+    const double x0 = a + r * std::sin(b);
+    const double x1 = a + da + r * std::sin(b - d_yaw);
+    f.from.emplace_back(x0, 100.0);
+    f.shift.emplace_back(x1 - x0, dy);
+  }
+  return f;
+}
+
+TEST(HeadTurnTest, FollowsTheAxisAndTheYawOfATurningCylinder) {
+  // A head turned 0.7 rad away turns on to 1.2 rad and back over 60 frames
+  // (2 s at 30 fps, as in turn_away), its axis bobbing; the visible points
+  // lie within 57 deg of the line of sight. Turning away, to the turn's
+  // peak (frames 0-14), the axis stays within 4 px (measured 2.2) and the
+  // yaw within 0.05 rad (0.033). On the way back the filtered rate lags
+  // the turn (kHeadTurnRateGain), and the axis' error then feeds back
+  // through the tracks' depths: the axis drifts (33 px at worst here, by
+  // 0.45 rad of yaw), a limit docs/evaluation.md reports; the landmarks
+  // take the face back from about 31 deg of yaw.
+  const double r = 80.0;
+  HeadTurn h;
+  h.radius_px = r;
+  h.yaw = 0.7;
+  h.yaw_rate = 0.035;  // the rate the last fits measured (true: 0.052)
+  h.axis_px = Eigen::Vector2d(300.0, 150.0);
+  double true_axis = 300.0, true_yaw = 0.7, true_y = 150.0;
+  double worst_axis = 0.0, worst_yaw = 0.0;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> beta(-1.0, 1.0);
+  for (int k = 0; k < 60; ++k) {
+    // yaw = 0.7 + 0.5 sin(pi k / 30): its increments.
+    const double d_yaw = 0.5 * (std::sin(M_PI * (k + 1) / 30.0) - std::sin(M_PI * k / 30.0));
+    const double da = 4.0 * std::sin(0.6 * k), dy = 3.0 * std::cos(0.6 * k);
+    std::vector<double> betas;
+    for (int i = 0; i < 30; ++i) betas.push_back(beta(rng));
+    const RegionFlow f = CylinderFlow(true_axis, r, da, dy, d_yaw, betas);
+    ASSERT_TRUE(UpdateHeadTurn(f, &h));
+    true_axis += da;
+    true_y += dy;
+    true_yaw += d_yaw;
+    EXPECT_NEAR(h.axis_px.y(), true_y, 1e-9) << "frame " << k;
+    if (k < 15) {
+      worst_axis = std::max(worst_axis, std::abs(h.axis_px.x() - true_axis));
+      worst_yaw = std::max(worst_yaw, std::abs(h.yaw - true_yaw));
+    }
+  }
+  std::cout << "[ turning cylinder ] frames 0-14: worst axis error " << worst_axis
+            << " px, yaw " << worst_yaw << " rad; after the way back: "
+            << h.axis_px.x() - true_axis << " px, " << h.yaw - true_yaw << " rad\n";
+  EXPECT_LT(worst_axis, 4.0);
+  EXPECT_LT(worst_yaw, 0.05);
+}
+
+TEST(HeadTurnTest, TracksAllFacingTheCameraGiveTranslationOnly) {
+  // All tracks at the same depth: the turn is not observable, the axis
+  // takes their common shift and the rate decays.
+  HeadTurn h;
+  h.radius_px = 80.0;
+  h.yaw = 0.5;
+  h.yaw_rate = 0.02;
+  h.axis_px = Eigen::Vector2d(300.0, 150.0);
+  const RegionFlow f = CylinderFlow(300.0, 80.0, 5.0, -2.0, 0.0, {-0.5, -0.5, -0.5, -0.5});
+  ASSERT_TRUE(UpdateHeadTurn(f, &h));
+  EXPECT_NEAR(h.yaw_rate, 0.02 * (1.0 - kHeadTurnRateGain), 1e-12);
+  EXPECT_NEAR(h.axis_px.y(), 148.0, 1e-9);
+  // Too few tracks, or no radius: no update.
+  HeadTurn before = h;
+  EXPECT_FALSE(UpdateHeadTurn(CylinderFlow(300.0, 80.0, 1, 1, 0, {0.1, 0.2}), &h));
+  EXPECT_EQ(h.axis_px, before.axis_px);
+  h.radius_px = 0.0;
+  EXPECT_FALSE(UpdateHeadTurn(f, &h));
+}
+
+}  // namespace
+}  // namespace steadiface
