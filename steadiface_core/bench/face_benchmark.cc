@@ -3,7 +3,9 @@
 // detection + landmarks), on a rendered frame with the astronaut portrait
 // as a billboard 0.45 m away, at 640x360, 1280x720 and 1920x1080; and a
 // robot's view (640x480, 60 deg): the face 2.75 m away, 30 px wide, tracked,
-// and the search with nobody in view, with and without the small-face tiles.
+// and the search with nobody in view, with and without the small-face tiles;
+// and a head followed past the landmarks (face/head_turn.h): its region's
+// tracks and the turning cylinder's update.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -11,8 +13,11 @@
 #include <memory>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "steadiface_core/face/face_tracker.h"
+#include "steadiface_core/face/head_region_motion.h"
+#include "steadiface_core/face/head_turn.h"
 #include "steadiface_core/sim/scene_renderer.h"
 
 namespace steadiface {
@@ -157,7 +162,44 @@ void BM_SearchWithNobodyInView(benchmark::State& state) {
   state.counters["worst_ms"] = worst;
 }
 
+// One followed frame's own cost (the landmarks are still tried in the box,
+// as BM_FaceTracking costs): the head region's KLT tracks into the next
+// frame (the picture moved by 2.5, 1.5 px) and the cylinder's update.
+void BM_FollowTurnedHead(benchmark::State& state) {
+  const Scene s = Make(state.range(0), state.range(1));
+  const std::unique_ptr<FaceTracker> t = MakeTracker(s, FaceTrackerOptions(), state);
+  if (!t) return;
+  FaceInfo fi;
+  if (!Track(t.get(), s, 1.0, &fi, state)) return;
+  if (!fi.valid) {
+    state.SkipWithError("the face was not acquired");
+    return;
+  }
+  cv::Mat grey, moved;
+  cv::cvtColor(s.frame, grey, cv::COLOR_BGR2GRAY);
+  const cv::Mat M = (cv::Mat_<double>(2, 3) << 1, 0, 2.5, 0, 1, 1.5);
+  cv::warpAffine(grey, moved, M, grey.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  HeadRegionMotion motion;
+  motion.Remember(grey, fi.box);
+  RegionFlow flow;
+  double tracks = 0.0;
+  for (auto _ : state) {
+    HeadTurn head;
+    head.radius_px = 1.5 * fi.scale_px;
+    head.axis_px = fi.centre_px;
+    if (!motion.Track(moved, &flow) || !UpdateHeadTurn(flow, &head)) {
+      state.SkipWithError("the head region was not followed");
+      break;
+    }
+    tracks = static_cast<double>(flow.shift.size());
+    benchmark::DoNotOptimize(head);
+  }
+  state.counters["tracks"] = tracks;
+  state.counters["face_px"] = fi.box.width;
+}
+
 BENCHMARK(BM_FaceTracking)->Apply(Args);
+BENCHMARK(BM_FollowTurnedHead)->Apply(Args);
 BENCHMARK(BM_SmallFaceTracking)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SearchWithNobodyInView)
     ->Args({640, 480, 0})

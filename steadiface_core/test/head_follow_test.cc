@@ -46,6 +46,13 @@ TEST(HeadRegionMotionTest, MeasuresAKnownSubPixelShiftAndForgetsOnClear) {
     EXPECT_GE(p.x(), 109.0);
     EXPECT_LE(p.x(), 211.0);
   }
+  // The camera's own rotation moved the picture: taken out, the region
+  // itself stood still.
+  RegionFlow own;
+  ASSERT_TRUE(motion.Track(b, &own, [](const Eigen::Vector2d&) {
+    return Eigen::Vector2d(3.25, -2.5);
+  }));
+  EXPECT_NEAR(own.mean_shift.norm(), 0.0, 0.1);
   motion.Clear();
   EXPECT_FALSE(motion.Track(b, &flow));
 }
@@ -76,13 +83,11 @@ RegionFlow CylinderFlow(double a, double r, double da, double dy, double d_yaw,
 TEST(HeadTurnTest, FollowsTheAxisAndTheYawOfATurningCylinder) {
   // A head turned 0.7 rad away turns on to 1.2 rad and back over 60 frames
   // (2 s at 30 fps, as in turn_away), its axis bobbing; the visible points
-  // lie within 57 deg of the line of sight. Turning away, to the turn's
-  // peak (frames 0-14), the axis stays within 4 px (measured 2.2) and the
-  // yaw within 0.05 rad (0.033). On the way back the filtered rate lags
-  // the turn (kHeadTurnRateGain), and the axis' error then feeds back
-  // through the tracks' depths: the axis drifts (33 px at worst here, by
-  // 0.45 rad of yaw), a limit docs/evaluation.md reports; the landmarks
-  // take the face back from about 31 deg of yaw.
+  // lie within 57 deg of the line of sight. The filtered rate lags the
+  // turn (kHeadTurnRateGain), and an error in the axis feeds back through
+  // the tracks' depths; at the default gain both stay bounded: measured
+  // worst 8.6 px and 0.125 rad on the way back, 3.3 px and 0.05 rad at the
+  // end (at a gain of 0.35: 33 px and 0.48 rad at worst).
   const double r = 80.0;
   HeadTurn h;
   h.radius_px = r;
@@ -105,16 +110,15 @@ TEST(HeadTurnTest, FollowsTheAxisAndTheYawOfATurningCylinder) {
     true_y += dy;
     true_yaw += d_yaw;
     EXPECT_NEAR(h.axis_px.y(), true_y, 1e-9) << "frame " << k;
-    if (k < 15) {
-      worst_axis = std::max(worst_axis, std::abs(h.axis_px.x() - true_axis));
-      worst_yaw = std::max(worst_yaw, std::abs(h.yaw - true_yaw));
-    }
+    worst_axis = std::max(worst_axis, std::abs(h.axis_px.x() - true_axis));
+    worst_yaw = std::max(worst_yaw, std::abs(h.yaw - true_yaw));
   }
-  std::cout << "[ turning cylinder ] frames 0-14: worst axis error " << worst_axis
-            << " px, yaw " << worst_yaw << " rad; after the way back: "
-            << h.axis_px.x() - true_axis << " px, " << h.yaw - true_yaw << " rad\n";
-  EXPECT_LT(worst_axis, 4.0);
-  EXPECT_LT(worst_yaw, 0.05);
+  std::cout << "[ turning cylinder ] worst axis error " << worst_axis << " px, yaw "
+            << worst_yaw << " rad; after the way back: " << h.axis_px.x() - true_axis
+            << " px, " << h.yaw - true_yaw << " rad\n";
+  EXPECT_LT(worst_axis, 10.0);
+  EXPECT_LT(worst_yaw, 0.15);
+  EXPECT_LT(std::abs(h.axis_px.x() - true_axis), 5.0);
 }
 
 TEST(HeadTurnTest, TracksAllFacingTheCameraGiveTranslationOnly) {

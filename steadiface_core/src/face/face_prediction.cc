@@ -42,4 +42,23 @@ bool FaceTracker::PredictLandmarks(Time stamp, const OrientationTimeline* tl,
   return true;
 }
 
+Eigen::Vector2d FaceTracker::CameraShift(const Eigen::Vector2d& from, Time stamp,
+                                         const OrientationTimeline* tl,
+                                         const RowTiming* timing) const {
+  if (tl == nullptr || timing == nullptr || !have_last_frame_) return Eigen::Vector2d::Zero();
+  Eigen::Quaterniond R0, R1;
+  if (!QuerySucceeded(tl->RealRotation(timing->RowTime(last_frame_, from.y()), &R0)) ||
+      !QuerySucceeded(tl->RealRotation(timing->RowTime(stamp, from.y()), &R1))) {
+    return Eigen::Vector2d::Zero();
+  }
+  const Eigen::Vector2d n = model_.PixelToNormalized(from);
+  Eigen::Vector2d w, m;
+  if (!model_.Project(n, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(), R0, &w) ||
+      !model_.Unproject(w, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(), R1, &m)) {
+    return Eigen::Vector2d::Zero();
+  }
+  const Eigen::Vector2d shift = model_.NormalizedToPixel(m) - from;
+  return shift.allFinite() ? shift : Eigen::Vector2d::Zero();
+}
+
 }  // namespace steadiface

@@ -23,6 +23,8 @@ using namespace face_internal;  // NOLINT: the tracker's own helpers
 namespace {
 // Follow's gate forgets a turn at this rate [rad/s].
 constexpr double kTurnMemoryRadPerS = 0.3;
+// While a head is followed, the detector runs on one frame in this many.
+constexpr int kFollowRedetectFrames = 3;
 }  // namespace
 
 Status FaceTracker::Create(const CameraModel& model,
@@ -59,6 +61,7 @@ void FaceTracker::Reset() {
   reference_yaw_ = 0.0;
   region_motion_.Clear();
   following_ = false;
+  have_last_frame_ = false;
   fitted_last_frame_ = false;
   have_fitted_pose_ = false;
   recent_abs_yaw_ = 0.0;
@@ -255,6 +258,8 @@ Status FaceTracker::Process(const cv::Mat& image, Time stamp,
   } else {
     Track(gray, full, stamp, timeline, timing, rot_ok, info);
   }
+  last_frame_ = stamp;
+  have_last_frame_ = true;
   // Periodic re-detection counts from the last attempt, found or not.
   frames_since_detect_ = info->detected ? 0 : frames_since_detect_ + 1;
   if (rot_ok && !last_landmarks_.empty()) {
@@ -320,8 +325,12 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
                        pbox.y - 0.5 * (g - 1) * pbox.height, g * pbox.width,
                        g * pbox.height);
   const cv::Rect roi = cv::Rect(big) & full;
-  const bool want_detect = force_detect_ || state_ == TrackingState::kLost ||
-                           frames_since_detect_ + 1 >= options_.redetect_every_frames;
+  // A followed head (Follow) is re-detected on every kFollowRedetectFrames-th
+  // frame only: its landmarks are still fitted in its box every frame, and
+  // the detector rarely finds a face turned that far.
+  const bool may_detect = !following_ || frames_since_detect_ + 1 >= kFollowRedetectFrames;
+  const bool want_detect = may_detect && (force_detect_ || state_ == TrackingState::kLost ||
+                                          frames_since_detect_ + 1 >= options_.redetect_every_frames);
   bool tried_detect = false;
   if (want_detect && roi.area() > 0) {
     tried_detect = true;
@@ -346,7 +355,7 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
     info->timings.landmarks_ms += MsSince(t1);
     ok = fit && Evaluate(&gray, c, false, &pc, info, &patch);
     // Always re-detect after a failure.
-    if (!ok && !tried_detect && roi.area() > 0) {
+    if (!ok && !tried_detect && may_detect && roi.area() > 0) {
       const FaceFailure first = info->failure;
       info->detected = true;
       double det_ms = 0.0;
@@ -368,7 +377,7 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
   }
   MarkFailure(info->failure == FaceFailure::kNone ? FaceFailure::kNoFace : info->failure,
               stamp, info);
-  if (Follow(gray, stamp, pc, info)) return;
+  if (Follow(gray, stamp, pc, timeline, timing, info)) return;
   region_motion_.Clear();
   // Keep following the lost face with the gyro, so re-detection looks
   // where it should be.
@@ -376,6 +385,7 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
 }
 
 bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d& pc,
+                         const OrientationTimeline* timeline, const RowTiming* timing,
                          FaceInfo* info) {
   // A face last fitted turned away whose landmarks now fail has most
   // likely turned past what the landmark model fits; its head is still in
@@ -399,11 +409,18 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
     head_turn_.axis_px =
         Mean(last_landmarks_) + Eigen::Vector2d(head_turn_.radius_px * std::sin(head_turn_.yaw), 0);
   }
+  // The head's own motion: the tracks beyond the camera's rotation; the
+  // axis then moves by both.
+  const HeadRegionMotion::CameraShift camera = [&](const Eigen::Vector2d& p) {
+    return CameraShift(p, stamp, timeline, timing);
+  };
   RegionFlow flow;
   HeadTurn next = head_turn_;
-  const bool moved = region_motion_.Track(gray, &flow) &&
+  const Eigen::Vector2d camera_at_axis = camera(next.axis_px);
+  const bool moved = region_motion_.Track(gray, &flow, camera) &&
                      (next.radius_px > 0.0 ? UpdateHeadTurn(flow, &next)
                                            : (next.axis_px += flow.mean_shift, true));
+  next.axis_px += camera_at_axis;
   const Eigen::Vector2d centre = next.FaceCentre();
   if (!moved || !(scale > 0.0) || (centre - pc).norm() > options_.max_jump * scale) {
     following_ = false;

@@ -53,9 +53,10 @@ Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
         << o.region_motion.min_inliers << " / " << o.region_motion.max_features;
   } else if (!(o.region_motion.max_forward_backward_px > 0.0) ||
              !(o.region_motion.inlier_share > 0.0) ||
+             !(o.region_motion.max_region_px >= 32.0) ||
              !(o.region_motion.search_margin >= 0.1 && o.region_motion.search_margin <= 3.0)) {
     err << "face.region_motion: max_forward_backward_px and inlier_share must be > 0, "
-           "search_margin in [0.1, 3]";
+           "max_region_px >= 32, search_margin in [0.1, 3]";
   } else if (!(o.appearance_update_rate >= 0.0 && o.appearance_update_rate <= 1.0)) {
     err << "face.appearance_update_rate must be in [0, 1], got "
         << o.appearance_update_rate;

@@ -42,32 +42,46 @@ void HeadRegionMotion::Remember(const cv::Mat& grey, const cv::Rect2d& region) {
   }
   // The crop holds the region and the reach of the search around it; the
   // next frame is cut at the same place (Lucas-Kanade pairs equal sizes).
+  // A large head is tracked on a copy scaled down to max_region_px: the
+  // cost stays that of a small one.
   const cv::Rect c = Grown(region, options_.search_margin, grey.size());
-  if (c.width < 16 || c.height < 16) return;
-  grey(c).copyTo(crop_);
-  origin_ = c.tl();
+  scale_ = std::min(1.0, options_.max_region_px / region.width);
+  const cv::Size size(cvRound(c.width * scale_), cvRound(c.height * scale_));
+  if (size.width < 16 || size.height < 16) return;
+  if (scale_ < 1.0) {
+    cv::resize(grey(c), crop_, size, 0, 0, cv::INTER_AREA);
+  } else {
+    grey(c).copyTo(crop_);
+  }
+  cut_ = c;
   region_ = region;
 }
 
-bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow) const {
+bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow,
+                             const CameraShift& camera) const {
   const HeadRegionMotionOptions& o = options_;
   if (crop_.empty() || grey.empty() || grey.type() != CV_8UC1) return false;
   // Corners inside the region's ellipse (the head, not the corners of its
   // box, where the background shows).
+  const double k = scale_;
   cv::Mat mask = cv::Mat::zeros(crop_.size(), CV_8U);
-  const cv::Point2d centre(region_.x + 0.5 * region_.width - origin_.x,
-                           region_.y + 0.5 * region_.height - origin_.y);
+  const cv::Point2d centre((region_.x + 0.5 * region_.width - cut_.x) * k,
+                           (region_.y + 0.5 * region_.height - cut_.y) * k);
   cv::ellipse(mask, cv::Point(cvRound(centre.x), cvRound(centre.y)),
-              cv::Size(cvRound(0.5 * region_.width), cvRound(0.5 * region_.height)), 0.0, 0.0,
-              360.0, cv::Scalar(255), cv::FILLED);
+              cv::Size(cvRound(0.5 * region_.width * k), cvRound(0.5 * region_.height * k)), 0.0,
+              0.0, 360.0, cv::Scalar(255), cv::FILLED);
   std::vector<cv::Point2f> p0;
-  const double spacing = std::max(3.0, region_.width / 12.0);
+  const double spacing = std::max(3.0, region_.width * k / 12.0);
   cv::goodFeaturesToTrack(crop_, p0, o.max_features, 0.01, spacing, mask);
   if (static_cast<int>(p0.size()) < o.min_inliers) return false;
-  // This frame cut where the remembered crop was.
-  const cv::Rect s(origin_, crop_.size());
-  if ((s & cv::Rect(0, 0, grey.cols, grey.rows)) != s) return false;
-  const cv::Mat now = grey(s);
+  // This frame cut where the remembered crop was, at its scale.
+  if ((cut_ & cv::Rect(0, 0, grey.cols, grey.rows)) != cut_) return false;
+  cv::Mat now;
+  if (k < 1.0) {
+    cv::resize(grey(cut_), now, crop_.size(), 0, 0, cv::INTER_AREA);
+  } else {
+    now = grey(cut_);
+  }
   const std::vector<cv::Point2f>& guess = p0;
   std::vector<cv::Point2f> p1 = p0, back = p0;
   std::vector<uchar> ok1, ok2;
@@ -83,9 +97,11 @@ bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow) const {
     if (!ok1[i] || !ok2[i]) continue;
     const cv::Point2f fb = back[i] - p0[i];
     if (std::hypot(fb.x, fb.y) > o.max_forward_backward_px) continue;
-    const cv::Point2f m = p1[i] - guess[i];  // the shift in frame pixels
-    d.emplace_back(m.x, m.y);
-    from.emplace_back(p0[i].x + origin_.x, p0[i].y + origin_.y);
+    const cv::Point2f m = p1[i] - guess[i];
+    const Eigen::Vector2d start(p0[i].x / k + cut_.x, p0[i].y / k + cut_.y);  // frame px
+    d.emplace_back(Eigen::Vector2d(m.x, m.y) / k -
+                   (camera ? camera(start) : Eigen::Vector2d::Zero()));
+    from.push_back(start);
   }
   if (static_cast<int>(d.size()) < o.min_inliers) return false;
   std::vector<double> dx, dy;

@@ -269,7 +269,13 @@ const FaceObservation* Pipeline::FaceStep(const cv::Mat& image, Time stamp,
       s = tracker_->Process(grey, stamp, &timeline_, &timing_, &f->face);
     }
     // A face error never stops stabilization: it is a frame without a face.
-    if (f->face.located()) {
+    // A followed head (turned past the landmarks) is held in global mode
+    // only: its landmarks are the last fit's shape moved with it, not its
+    // outline, and the layered and composite modes cut the subject region
+    // from them (their background is never moved by the face).
+    const bool usable =
+        f->face.valid || (f->face.followed && options_.warp.mode == WarpMode::kGlobal);
+    if (usable) {
       *observation = f->face.ToObservation();
       obs = observation;
     }

@@ -170,7 +170,12 @@ class FaceTracker {
   // A turned face whose landmarks failed: its last landmarks moved with
   // the head region (options_.follow_turned_s); false when not followed.
   bool Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d& predicted_centre,
-              FaceInfo* info);
+              const OrientationTimeline* timeline, const RowTiming* timing, FaceInfo* info);
+  // Where the camera's rotation moves a still point from the previous
+  // frame's pixel into this frame's (face_prediction.cc); zero without the
+  // gyro.
+  Eigen::Vector2d CameraShift(const Eigen::Vector2d& from_px, Time stamp,
+                              const OrientationTimeline* timeline, const RowTiming* timing) const;
   void Fill(const std::vector<Eigen::Vector2d>& landmarks, FaceInfo* info) const;
   bool PredictLandmarks(Time stamp, const OrientationTimeline* timeline,
                         const RowTiming* timing,
@@ -214,6 +219,8 @@ class FaceTracker {
   bool fitted_last_frame_ = false;
   double recent_abs_yaw_ = 0.0;                  // the turn lately, for Follow [rad]
   Time last_located_;                            // last fitted or followed
+  Time last_frame_;                              // the previous frame's stamp
+  bool have_last_frame_ = false;
   // Box relative to the landmark extent: (dx, dy, sx, sy).
   Eigen::Vector4d box_model_ = Eigen::Vector4d(0.0, -0.1, 1.05, 1.05);
   Time last_seen_;

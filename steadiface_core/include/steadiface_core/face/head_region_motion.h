@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -13,7 +14,11 @@ struct HeadRegionMotionOptions {
   int max_features = 80;
   /// Fewer tracks than this that agree with their median: no measurement [-].
   int min_inliers = 10;
-  /// A track whose backward track misses its start by more is dropped [px].
+  /// A region wider than this is tracked on a copy scaled down to it, so a
+  /// large head costs what a small one does [px].
+  double max_region_px = 160.0;
+  /// A track whose backward track misses its start by more is dropped
+  /// [px of the tracked copy].
   double max_forward_backward_px = 0.7;
   /// A track agrees with the median shift within this share of the region's
   /// width, and at least 1.5 px [-].
@@ -38,7 +43,8 @@ struct RegionFlow {
 /// The image motion of one region (a head) between consecutive frames,
 /// from sparse pyramidal Lucas-Kanade tracks with a forward-backward check
 /// and the median of their shifts. It keeps only the grey crop around the
-/// last region (the region grown by search_margin), never a whole frame.
+/// last region (the region grown by search_margin, at most max_region_px
+/// wide before the margin), never a whole frame.
 /// Not thread-safe.
 class HeadRegionMotion {
  public:
@@ -47,17 +53,25 @@ class HeadRegionMotion {
 
   /// Keeps the crop of `grey` around `region` [px] for the next Track.
   void Remember(const cv::Mat& grey, const cv::Rect2d& region);
+  /// Where the camera's own rotation moves a still point seen at a pixel
+  /// of the previous frame, in this one (the gyro, each row at its time).
+  using CameraShift = std::function<Eigen::Vector2d(const Eigen::Vector2d& from_px)>;
+
   /// The remembered region's tracks into `grey`, those that agree with
-  /// their median shift. False when there is no remembered region or fewer
-  /// than min_inliers tracks agree (or under half of those tracked).
-  bool Track(const cv::Mat& grey, RegionFlow* flow) const;
+  /// their median shift. With `camera` (optional), each shift is taken
+  /// beyond the camera's rotation (rolling shutter included), so that the
+  /// flow is the region's own motion. False when there is no remembered
+  /// region or fewer than min_inliers tracks agree (or under half of those
+  /// tracked).
+  bool Track(const cv::Mat& grey, RegionFlow* flow, const CameraShift& camera = {}) const;
   void Clear();
   bool ready() const { return !crop_.empty(); }
 
  private:
   const HeadRegionMotionOptions options_;
-  cv::Mat crop_;                  // grey around region_
-  cv::Point origin_;              // crop_'s top-left in the frame [px]
+  cv::Mat crop_;                  // grey around region_, scaled by scale_
+  cv::Rect cut_;                  // where crop_ was cut from the frame [px]
+  double scale_ = 1.0;            // crop_ px per frame px
   cv::Rect2d region_;             // the region in the frame [px]
 };
 

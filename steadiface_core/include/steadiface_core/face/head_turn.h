@@ -6,12 +6,15 @@
 
 namespace steadiface {
 
-/// The gain of the first-order filter on the yaw's rate per frame: one
-/// frame's flow measures the turn with an error about as large as the turn
-/// itself (rolling shutter, pitch, a few dozen tracks), so the rate follows
-/// the measurements over about three frames and the yaw does not
-/// random-walk over a turn of two seconds [-].
-constexpr double kHeadTurnRateGain = 0.35;
+/// The gain of the first-order filter on the yaw's rate per frame. The
+/// flow is taken beyond the camera's rotation (the gyro, each row at its
+/// time), so one frame's measured turn is nearly clean; a light filter
+/// still steadies it on real footage. The rate's lag after a reversal by D
+/// leaves the yaw behind by D (1 - gain) / gain, and a wrong axis feeds
+/// back through the tracks' depths, so the gain is high: on turn_away
+/// (seeds 1-3) 0.35 / 0.5 / 0.7 / 1.0 give the head 5.2-6.3 / 4.8-5.7 /
+/// 4.6-5.6 / 4.6-5.6 px [-].
+constexpr double kHeadTurnRateGain = 0.7;
 
 /// A head followed through a turn past what the landmark model fits, as a
 /// vertical cylinder about its turning axis: the cylinder head model
