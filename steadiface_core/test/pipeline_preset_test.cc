@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "score_util.h"
 #include "sim_util.h"
 #include "steadiface_core/common/so3.h"
 #include "steadiface_core/eval/run_methods.h"
@@ -27,12 +28,7 @@ using testing_util::MakeSimulator;
 // stabilizer's record.
 eval::Score ScoreMethod(const sim::Simulator& s, eval::Method method,
                         std::vector<StabilizerFrame>* frames) {
-  const PipelineOptions po = eval::OptionsFor(s, method);
-  std::unique_ptr<eval::Scorecard> card;
-  Status st = eval::MakeScorecard(s, po, &card);
-  if (st.ok()) st = eval::RunMethod(s, method, po, false, card.get(), frames);
-  EXPECT_TRUE(st.ok()) << st.message();
-  return st.ok() ? card->Compute() : eval::Score();
+  return testing_util::ScoreRun(s, method, {}, frames);
 }
 
 struct PresetResult {
@@ -278,13 +274,7 @@ namespace steadiface {
 namespace {
 
 eval::Score RunCrop(const sim::Simulator& s, eval::Method method, CropMode mode) {
-  PipelineOptions po = eval::OptionsFor(s, method);
-  po.crop.mode = mode;
-  std::unique_ptr<eval::Scorecard> card;
-  EXPECT_TRUE(eval::MakeScorecard(s, po, &card).ok());
-  const Status st = eval::RunMethod(s, method, po, false, card.get(), nullptr);
-  EXPECT_TRUE(st.ok()) << st.message();
-  return card->Compute();
+  return testing_util::ScoreRun(s, method, [mode](PipelineOptions* o) { o->crop.mode = mode; });
 }
 
 // The dynamic crop (output/crop dynamic): on a camera at rest the view

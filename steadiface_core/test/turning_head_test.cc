@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "score_util.h"
 #include "sim_util.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/scorecard.h"
@@ -25,14 +26,13 @@ using testing_util::MakeSimulator;
 
 eval::Score RunWith(const sim::Simulator& s, eval::Method m, double pivot_depth,
                     std::vector<StabilizerFrame>* frames = nullptr, double follow_s = -1.0) {
-  PipelineOptions o = eval::OptionsFor(s, m);
-  if (pivot_depth >= 0.0) o.stabilizer.dynamic.pose_pivot_depth = pivot_depth;
-  if (follow_s >= 0.0) o.face.follow_turned_s = follow_s;
-  std::unique_ptr<eval::Scorecard> card;
-  EXPECT_TRUE(eval::MakeScorecard(s, o, &card).ok());
-  const Status st = eval::RunMethod(s, m, o, false, card.get(), frames);
-  EXPECT_TRUE(st.ok()) << st.message();
-  return card->Compute();
+  return testing_util::ScoreRun(
+      s, m,
+      [=](PipelineOptions* o) {
+        if (pivot_depth >= 0.0) o->stabilizer.dynamic.pose_pivot_depth = pivot_depth;
+        if (follow_s >= 0.0) o->face.follow_turned_s = follow_s;
+      },
+      frames);
 }
 
 // drift: a standing person whose head drifts and turns (yaw 12 deg RMS).

@@ -107,6 +107,8 @@ void Stabilizer::Reset() {
   reach_limit_ = 0.0;
   background_ = LayerState();
   has_held_face_ = false;
+  last_source_ = FaceSource::kNone;
+  handback_ = Eigen::Vector2d::Zero();
   dynamic_.Reset();
   background_dynamic_.Reset();
   pose_centre_.Reset();
@@ -129,11 +131,13 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   // The landmarks moved to the pose-invariant head centre: E_f, Eq. 1 and
   // the held face read it.
   FaceObservation invariant;
+  FaceObservation handed;
   if (use_face) {
     invariant = pose_centre_.Apply(*face, dt);
-    face = &invariant;
+    face = HandBackStep(layer, invariant, dt, f, &handed);
   } else {
     pose_centre_.Reset();
+    handback_ = Eigen::Vector2d::Zero();
   }
   // A camera fixed in the world at the epoch's first real rotation: what
   // it sees does not depend on where the gyro integration started.
@@ -153,6 +157,10 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
 
   FaceObservation held;
   const FaceObservation* fit_face = HeldFaceStep(layer, use_face ? face : nullptr, w, &held, &f);
+  last_source_ = f.flags.held_face ? FaceSource::kHeld
+                 : !use_face       ? FaceSource::kNone
+                 : face->followed  ? FaceSource::kFollowed
+                                   : FaceSource::kFitted;
 
   // The background layer does not depend on the subject's: with a reach,
   // it is solved first, and H is held within reach of where it shows the
@@ -266,23 +274,52 @@ const FaceObservation* Stabilizer::HeldFaceStep(const LayerState& layer,
   // usable), or while w_f fades out after a loss, the last one held fixed
   // in the world.
   const FaceObservation* fit_face = face;
-  if (face == nullptr && has_held_face_ && layer.has_H && w.fit > 1e-3 * options_.weights.fit) {
-    *held = held_face_;
-    bool ok = true;
-    for (size_t i = 0; i < held->landmarks.size() && ok; ++i) {
-      const Eigen::Quaterniond R_row =
-          held->landmark_rows.empty() ? f->R_r : f->rows.At(held->landmark_rows[i]);
-      ok = model_.Unproject(held_face_.landmarks[i], R_reference_, Eigen::Vector2d::Zero(),
-                            R_row, &held->landmarks[i]);
-    }
-    if (ok) {
-      ComputeCentreAndScale(held);
-      fit_face = held;
-      f->flags.held_face = true;
-    }
+  if (face == nullptr && has_held_face_ && layer.has_H && w.fit > 1e-3 * options_.weights.fit &&
+      HeldFaceNow(*f, held)) {
+    fit_face = held;
+    f->flags.held_face = true;
   }
   if (fit_face == nullptr) has_held_face_ = false;
   return fit_face;
+}
+
+bool Stabilizer::HeldFaceNow(const StabilizerFrame& f, FaceObservation* held) const {
+  *held = held_face_;
+  for (size_t i = 0; i < held->landmarks.size(); ++i) {
+    const Eigen::Quaterniond R_row =
+        held->landmark_rows.empty() ? f.R_r : f.rows.At(held->landmark_rows[i]);
+    if (!model_.Unproject(held_face_.landmarks[i], R_reference_, Eigen::Vector2d::Zero(), R_row,
+                          &held->landmarks[i])) {
+      return false;
+    }
+  }
+  ComputeCentreAndScale(held);
+  return held->centre.allFinite();
+}
+
+const FaceObservation* Stabilizer::HandBackStep(const LayerState& layer,
+                                                const FaceObservation& face, double dt,
+                                                const StabilizerFrame& f, FaceObservation* out) {
+  // A face back after it was held (lost) sits where the output did not
+  // follow it meanwhile: the head's own motion during the loss. Shifted
+  // back onto the held face, it rejoins its landmarks over handback_time_s
+  // instead of pulling the camera in one frame. (Fitted landmarks after a
+  // followed head are taken as they come: handed back so, turn_away's head
+  // was up to 21 % less steady; docs/evaluation.md.)
+  FaceObservation last;
+  if (last_source_ == FaceSource::kHeld && has_held_face_ && layer.has_H &&
+      options_.dynamic.handback_time_s > 0.0 && HeldFaceNow(f, &last)) {
+    handback_ = face.centre - last.centre;
+  } else if (dt > 0.0 && options_.dynamic.handback_time_s > 0.0) {
+    handback_ *= std::exp(-dt / options_.dynamic.handback_time_s);
+  } else {
+    handback_.setZero();
+  }
+  if (!handback_.allFinite()) handback_.setZero();
+  *out = face;
+  for (auto& l : out->landmarks) l -= handback_;
+  out->centre -= handback_;
+  return out;
 }
 
 void Stabilizer::HeadTargetStep(const LayerState& layer, const FaceObservation* fit_face,

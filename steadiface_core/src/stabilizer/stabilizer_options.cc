@@ -50,6 +50,7 @@ Status ValidateStabilizerOptions(const StabilizerOptions& o) {
       Range("terms.protrusion_samples_per_edge", t.protrusion_samples_per_edge,
             2, 256),
       Range("dynamic.fade_time", d.fade_time_s, 0, 10),
+      Range("dynamic.handback_time", d.handback_time_s, 0, 10),
       Range("dynamic.gyro_window", d.gyro_window_s, 0.02, 10),
       Range("dynamic.gyro_still", d.gyro_still_rad_s, 0, 10),
       Range("dynamic.gyro_active", d.gyro_active_rad_s, d.gyro_still_rad_s + 1e-6, 20),

@@ -238,6 +238,14 @@ class Stabilizer {
   // Initial pose (Eq. 12).
   void InitialPoseStep(const LayerState& layer, const StabilizerFrame& f,
                        Eigen::Quaterniond* R_v0, Eigen::Vector2d* t0) const;
+  // The face shifted by the hand-back offset: a face back after it was
+  // held jumps by what the output did not follow meanwhile; the jump is
+  // taken up over options_.dynamic.handback_time_s (written to *out).
+  const FaceObservation* HandBackStep(const LayerState& layer, const FaceObservation& face,
+                                      double dt, const StabilizerFrame& f, FaceObservation* out);
+  // The held face where the world-fixed reference camera puts it in this
+  // frame (f: R_r and the rows); false when it cannot be projected.
+  bool HeldFaceNow(const StabilizerFrame& f, FaceObservation* held) const;
   // The face E_f fits: this frame's, or the held one while w_f fades out
   // (then written to *held); null when none.
   const FaceObservation* HeldFaceStep(const LayerState& layer, const FaceObservation* face,
@@ -316,6 +324,11 @@ class Stabilizer {
   // the fade-out after a loss.
   bool has_held_face_ = false;
   FaceObservation held_face_;
+  // Where the last frame's face came from, and the hand-back offset
+  // (HandBackStep) [normalized].
+  enum class FaceSource { kNone, kFitted, kFollowed, kHeld };
+  FaceSource last_source_ = FaceSource::kNone;
+  Eigen::Vector2d handback_ = Eigen::Vector2d::Zero();
   // The slow part of where the background layer shows the face
   // (subject_reach_lowpass_hz), and the frame (stats_.frames) it was last
   // fed: it restarts after a frame without it.

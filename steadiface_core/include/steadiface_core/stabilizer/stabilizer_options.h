@@ -54,6 +54,11 @@ struct DynamicWeightOptions {
   /// Time constant of every weight change, including the fade in/out of w_f
   /// when the face appears or is lost [s].
   double fade_time_s = 0.25;
+  /// A face back after a loss (E_f fitted the held face meanwhile) jumps
+  /// by the head's own motion during the loss; it is shifted back onto the
+  /// held face and rejoins its landmarks with this time constant instead
+  /// of pulling the camera in one frame; 0 = at once [s].
+  double handback_time_s = 0.1;
   /// Window of the mean |omega| [s].
   double gyro_window_s = 0.5;
   /// Mean |omega| at or below which the camera counts as still [rad/s].
