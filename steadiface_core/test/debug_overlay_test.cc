@@ -45,6 +45,21 @@ TEST(DebugOverlayTest, DrawsLandmarksCentreTargetAndFootprint) {
   EXPECT_TRUE(changed(320, 48));
   EXPECT_FALSE(changed(200, 240));  // untouched interior
   EXPECT_TRUE(changed(20, 18));     // text
+  // A followed head's landmarks are drawn too, in orange (BGR 0, 140, 255),
+  // where a fitted face's are green; a face neither fitted nor followed is
+  // not drawn.
+  const cv::Vec3b green_dot = out.at<cv::Vec3b>(200, 300);
+  face.valid = false;
+  face.followed = true;
+  face.state = TrackingState::kLost;
+  DrawDebugOverlay(input, m, w->protrusion(), &face, &f, &out);
+  const cv::Vec3b orange_dot = out.at<cv::Vec3b>(200, 300);
+  EXPECT_GT(green_dot[1], green_dot[2]);
+  EXPECT_GT(orange_dot[2], orange_dot[1]);
+  EXPECT_GT(orange_dot[2], 200);
+  face.followed = false;
+  DrawDebugOverlay(input, m, w->protrusion(), &face, &f, &out);
+  EXPECT_FALSE(changed(300, 200));
   // Null inputs draw nothing but the copy.
   DrawDebugOverlay(input, m, w->protrusion(), nullptr, nullptr, &out);
   EXPECT_EQ(cv::norm(out, cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(128)), cv::NORM_INF), 0.0);

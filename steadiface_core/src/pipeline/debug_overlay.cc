@@ -16,11 +16,13 @@ cv::Point2f P(const Eigen::Vector2d& p) {
   return cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
 }
 
-// The landmarks (green dots) and their centre C (yellow cross).
+// The landmarks (green dots; orange when a head turned past them is
+// followed: FaceInfo::followed) and their centre C (yellow cross).
 void DrawFace(const FaceInfo& face, double s, int th, cv::Mat* out) {
-  const cv::Scalar green(0, 220, 0), yellow(0, 230, 255);
+  const cv::Scalar green(0, 220, 0), orange(0, 140, 255), yellow(0, 230, 255);
+  const cv::Scalar& dots = face.valid ? green : orange;
   for (const auto& p : face.landmarks_px) {
-    cv::circle(*out, P(p), static_cast<int>(2 * s), green, cv::FILLED, cv::LINE_AA);
+    cv::circle(*out, P(p), static_cast<int>(2 * s), dots, cv::FILLED, cv::LINE_AA);
   }
   const cv::Point2f c = P(face.centre_px);
   const float r = static_cast<float>(8 * s);
@@ -64,10 +66,10 @@ std::vector<std::string> StateLines(const FaceInfo* face, const StabilizerFrame*
   std::vector<std::string> lines;
   char buf[160];
   if (face != nullptr) {
-    std::snprintf(buf, sizeof(buf), "face: %s%s%s conf %.2f", TrackingStateName(face->state),
+    std::snprintf(buf, sizeof(buf), "face: %s%s%s%s conf %.2f", TrackingStateName(face->state),
                   face->failure != FaceFailure::kNone ? " / " : "",
                   face->failure != FaceFailure::kNone ? FaceFailureName(face->failure) : "",
-                  face->confidence);
+                  face->followed ? ", head followed" : "", face->confidence);
     lines.emplace_back(buf);
     if (face->has_pose) {
       std::snprintf(buf, sizeof(buf), "pose yaw %.0f pitch %.0f roll %.0f deg",
@@ -106,7 +108,7 @@ void DrawDebugOverlay(const cv::Mat& input, const CameraModel& model,
   }
   const double s = std::max(1.0, out->cols / 640.0);  // line scale
   const int th = static_cast<int>(std::lround(s));
-  if (face != nullptr && face->valid) DrawFace(*face, s, th, out);
+  if (face != nullptr && face->located()) DrawFace(*face, s, th, out);
   if (frame != nullptr && !frame->rows.empty()) DrawFootprint(model, protrusion, *frame, s, th, out);
   // Text block.
   const double fs = 0.5 * s;
