@@ -30,15 +30,21 @@ bool FaceTracker::PredictLandmarks(Time stamp, const OrientationTimeline* tl,
   // A world-fixed face seen from the rotated camera: through the world
   // frame with the previous and the current real rotation.
   for (auto& p : *predicted) {
-    const Eigen::Vector2d n = model_.PixelToNormalized(p);
-    Eigen::Vector2d w, m;
-    if (model_.Project(n, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(),
-                       last_rotation_, &w) &&
-        model_.Unproject(w, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(),
-                         R_now, &m)) {
-      p = model_.NormalizedToPixel(m);
-    }
+    Eigen::Vector2d m;
+    if (SeenAfterRotation(p, last_rotation_, R_now, &m)) p = m;
   }
+  return true;
+}
+
+bool FaceTracker::SeenAfterRotation(const Eigen::Vector2d& px, const Eigen::Quaterniond& R0,
+                                    const Eigen::Quaterniond& R1, Eigen::Vector2d* out) const {
+  const Eigen::Vector2d n = model_.PixelToNormalized(px);
+  Eigen::Vector2d w, m;
+  if (!model_.Project(n, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(), R0, &w) ||
+      !model_.Unproject(w, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(), R1, &m)) {
+    return false;
+  }
+  *out = model_.NormalizedToPixel(m);
   return true;
 }
 
@@ -51,13 +57,9 @@ Eigen::Vector2d FaceTracker::CameraShift(const Eigen::Vector2d& from, Time stamp
       !QuerySucceeded(tl->RealRotation(timing->RowTime(stamp, from.y()), &R1))) {
     return Eigen::Vector2d::Zero();
   }
-  const Eigen::Vector2d n = model_.PixelToNormalized(from);
-  Eigen::Vector2d w, m;
-  if (!model_.Project(n, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(), R0, &w) ||
-      !model_.Unproject(w, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero(), R1, &m)) {
-    return Eigen::Vector2d::Zero();
-  }
-  const Eigen::Vector2d shift = model_.NormalizedToPixel(m) - from;
+  Eigen::Vector2d m;
+  if (!SeenAfterRotation(from, R0, R1, &m)) return Eigen::Vector2d::Zero();
+  const Eigen::Vector2d shift = m - from;
   return shift.allFinite() ? shift : Eigen::Vector2d::Zero();
 }
 

@@ -50,7 +50,6 @@ FaceObservation FaceInfo::ToObservation() const {
   o.centre = centre_normalized;
   o.scale = scale_normalized;
   o.confidence = confidence;
-  o.followed = followed && !valid;
   o.has_pose = has_pose;
   o.yaw = yaw;
   o.pitch = pitch;

@@ -107,7 +107,7 @@ void Stabilizer::Reset() {
   reach_limit_ = 0.0;
   background_ = LayerState();
   has_held_face_ = false;
-  last_source_ = FaceSource::kNone;
+  held_last_frame_ = false;
   handback_ = Eigen::Vector2d::Zero();
   dynamic_.Reset();
   background_dynamic_.Reset();
@@ -157,10 +157,7 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
 
   FaceObservation held;
   const FaceObservation* fit_face = HeldFaceStep(layer, use_face ? face : nullptr, w, &held, &f);
-  last_source_ = f.flags.held_face ? FaceSource::kHeld
-                 : !use_face       ? FaceSource::kNone
-                 : face->followed  ? FaceSource::kFollowed
-                                   : FaceSource::kFitted;
+  held_last_frame_ = f.flags.held_face;
 
   // The background layer does not depend on the subject's: with a reach,
   // it is solved first, and H is held within reach of where it shows the
@@ -307,7 +304,7 @@ const FaceObservation* Stabilizer::HandBackStep(const LayerState& layer,
   // followed head are taken as they come: handed back so, turn_away's head
   // was up to 21 % less steady; docs/evaluation.md.)
   FaceObservation last;
-  if (last_source_ == FaceSource::kHeld && has_held_face_ && layer.has_H &&
+  if (held_last_frame_ && has_held_face_ && layer.has_H &&
       options_.dynamic.handback_time_s > 0.0 && HeldFaceNow(f, &last)) {
     handback_ = face.centre - last.centre;
   } else if (dt > 0.0 && options_.dynamic.handback_time_s > 0.0) {

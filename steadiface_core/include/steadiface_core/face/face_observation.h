@@ -24,10 +24,6 @@ struct FaceObservation {
   double scale = 0.0;
   /// Tracking confidence in [0, 1].
   double confidence = 0.0;
-  /// The landmarks were not fitted this frame but moved with a head turned
-  /// past them (FaceInfo::followed): a position of another source, which
-  /// the stabilizer hands back smoothly when fitted landmarks return.
-  bool followed = false;
   /// Whether yaw/pitch/roll below are valid.
   bool has_pose = false;
   /// Head pose relative to facing the camera [rad].

@@ -176,6 +176,10 @@ class FaceTracker {
   // gyro.
   Eigen::Vector2d CameraShift(const Eigen::Vector2d& from_px, Time stamp,
                               const OrientationTimeline* timeline, const RowTiming* timing) const;
+  // Where a still point seen at `px` under real rotation R0 is seen under
+  // R1 (PredictLandmarks, CameraShift); false when it does not project.
+  bool SeenAfterRotation(const Eigen::Vector2d& px, const Eigen::Quaterniond& R0,
+                         const Eigen::Quaterniond& R1, Eigen::Vector2d* out) const;
   void Fill(const std::vector<Eigen::Vector2d>& landmarks, FaceInfo* info) const;
   bool PredictLandmarks(Time stamp, const OrientationTimeline* timeline,
                         const RowTiming* timing,

@@ -324,10 +324,9 @@ class Stabilizer {
   // the fade-out after a loss.
   bool has_held_face_ = false;
   FaceObservation held_face_;
-  // Where the last frame's face came from, and the hand-back offset
+  // The last frame fitted the held face, and the hand-back offset
   // (HandBackStep) [normalized].
-  enum class FaceSource { kNone, kFitted, kFollowed, kHeld };
-  FaceSource last_source_ = FaceSource::kNone;
+  bool held_last_frame_ = false;
   Eigen::Vector2d handback_ = Eigen::Vector2d::Zero();
   // The slow part of where the background layer shows the face
   // (subject_reach_lowpass_hz), and the frame (stats_.frames) it was last
