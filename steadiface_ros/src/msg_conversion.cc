@@ -497,6 +497,7 @@ void FillGyroVideoCheck(const steadiface::PipelineFrame& pf, steadiface::Stabili
     m.visual_tracked = static_cast<uint32_t>(std::max(0, pf.visual.tracked));
     m.visual_inliers = static_cast<uint32_t>(std::max(0, pf.visual.inliers));
     m.visual_residual_px = pf.visual.residual_px;
+    m.visual_turn_error_px = pf.visual.turn_error_px;
   }
 }
 
@@ -510,8 +511,8 @@ void ZeroNonFinite(steadiface::StabilizerState* out) {
                     &m.energy_translation, &m.energy_protrusion, &m.mean_angular_speed,
                     &m.face_shape_residual, &m.face_spread_ratio, &m.face_jump,
                     &m.face_appearance, &m.imu_offset_applied_s, &m.visual_residual_px,
-                    &m.layer_blend, &m.layer_blend_step, &m.band_px, &m.layer_offset_px,
-                    &m.layer_offset_capped_px, &m.layer_shift_px, &m.layer_keep,
+                    &m.visual_turn_error_px, &m.layer_blend, &m.layer_blend_step, &m.band_px,
+                    &m.layer_offset_px, &m.layer_offset_capped_px, &m.layer_shift_px, &m.layer_keep,
                     &m.min_cell_ratio, &m.matte_mean, &m.uncovered_px, &m.plate_share,
                     &m.fallback_share, &m.plate_coverage}) {
     clean(*v);

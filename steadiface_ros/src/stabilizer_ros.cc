@@ -334,6 +334,7 @@ void StabilizerRos::DiagRotationSource(diagnostic_updater::DiagnosticStatusWrapp
   s.add("tracked features", w.visual.tracked);
   s.add("inliers", w.visual.inliers);
   s.add("residual [px]", w.visual.residual_px);
+  s.add("turn standard error [px]", w.visual.turn_error_px);
   s.add("time [ms]", w.visual.ms);
   const std::string what = w.rotation_source == "auto" ? "visual (no IMU data)" : "visual";
   if (!w.pipeline_ready) {

@@ -130,6 +130,8 @@ TEST(WrapperTest, WithoutAnImuTheVideoGivesTheRotation) {
   EXPECT_EQ(w.CurrentStatus().counters.from_video, st.images.size());
   EXPECT_TRUE(w.CurrentStatus().visual.valid);
   EXPECT_GE(w.CurrentStatus().visual.inliers, 20);
+  EXPECT_GT(w.CurrentStatus().visual.turn_error_px, 0.0);
+  EXPECT_LT(w.CurrentStatus().visual.turn_error_px, 0.75);
   ExpectAllFinite(sink);
   const std::vector<double> a = turns(sink), b = turns(imu_sink);
   ASSERT_EQ(a.size(), b.size());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <Eigen/Dense>
@@ -32,35 +33,47 @@ std::vector<int> Inliers(const std::vector<BearingPair>& pairs,
   return in;
 }
 
+using Matrix9 = Eigen::Matrix<double, 9, 9>;
+
+// The Gauss-Newton normal equations of the pairs `in` at `m`, priors
+// included. The Jacobian takes the rotation as small (b2 + b2 x dphi for a
+// change dphi): one frame's turn is a few degrees, and the residuals
+// themselves are exact.
+void NormalEquations(const std::vector<BearingPair>& pairs,
+                     const std::vector<int>& in, const Motion& m,
+                     const MotionPrior& prior, Matrix9* JtJ, Motion* Jtr) {
+  JtJ->setZero();
+  Jtr->setZero();
+  for (int i : in) {
+    const BearingPair& p = pairs[i];
+    const Eigen::Vector3d b2 = Moved(m, p);
+    const Eigen::Vector2d r = b2.head<2>() / b2.z() - p.n2;
+    Eigen::Matrix<double, 2, 3> Jp;  // d(x/z, y/z) / d b2
+    Jp << 1.0 / b2.z(), 0.0, -b2.x() / (b2.z() * b2.z()), 0.0, 1.0 / b2.z(),
+        -b2.y() / (b2.z() * b2.z());
+    Eigen::Matrix3d skew;  // d b2 / d phi, with b2 = Exp(-phi) b1
+    skew << 0.0, -b2.z(), b2.y(), b2.z(), 0.0, -b2.x(), -b2.y(), b2.x(), 0.0;
+    const Eigen::Matrix<double, 2, 3> Jphi = Jp * skew;
+    Eigen::Matrix<double, 2, 9> J;
+    J << p.c * Jphi, p.d * Jphi, p.e * Jphi;
+    *JtJ += J.transpose() * J;
+    *Jtr += J.transpose() * r;
+  }
+  // The priors: alpha |alpha|^2 + beta |beta|^2.
+  JtJ->diagonal().segment<3>(3).array() += prior.alpha;
+  Jtr->segment<3>(3) += prior.alpha * m.segment<3>(3);
+  JtJ->diagonal().tail<3>().array() += prior.beta;
+  Jtr->tail<3>() += prior.beta * m.tail<3>();
+}
+
 // Gauss-Newton on the pairs `in` (9 unknowns), damped a little so that a
-// triple's nearly singular system stays bounded. The Jacobian takes the
-// rotation as small (b2 + b2 x dphi for a change dphi): one frame's turn
-// is a few degrees, and the residuals themselves are exact.
+// triple's nearly singular system stays bounded.
 Motion Refine(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
               Motion m, int iterations, const MotionPrior& prior) {
   for (int iter = 0; iter < iterations; ++iter) {
-    Eigen::Matrix<double, 9, 9> JtJ = Eigen::Matrix<double, 9, 9>::Zero();
-    Eigen::Matrix<double, 9, 1> Jtr = Eigen::Matrix<double, 9, 1>::Zero();
-    for (int i : in) {
-      const BearingPair& p = pairs[i];
-      const Eigen::Vector3d b2 = Moved(m, p);
-      const Eigen::Vector2d r = b2.head<2>() / b2.z() - p.n2;
-      Eigen::Matrix<double, 2, 3> Jp;  // d(x/z, y/z) / d b2
-      Jp << 1.0 / b2.z(), 0.0, -b2.x() / (b2.z() * b2.z()), 0.0, 1.0 / b2.z(),
-          -b2.y() / (b2.z() * b2.z());
-      Eigen::Matrix3d skew;  // d b2 / d phi, with b2 = Exp(-phi) b1
-      skew << 0.0, -b2.z(), b2.y(), b2.z(), 0.0, -b2.x(), -b2.y(), b2.x(), 0.0;
-      const Eigen::Matrix<double, 2, 3> Jphi = Jp * skew;
-      Eigen::Matrix<double, 2, 9> J;
-      J << p.c * Jphi, p.d * Jphi, p.e * Jphi;
-      JtJ += J.transpose() * J;
-      Jtr += J.transpose() * r;
-    }
-    // The priors: alpha |alpha|^2 + beta |beta|^2.
-    JtJ.diagonal().segment<3>(3).array() += prior.alpha;
-    Jtr.segment<3>(3) += prior.alpha * m.segment<3>(3);
-    JtJ.diagonal().tail<3>().array() += prior.beta;
-    Jtr.tail<3>() += prior.beta * m.tail<3>();
+    Matrix9 JtJ;
+    Motion Jtr;
+    NormalEquations(pairs, in, m, prior, &JtJ, &Jtr);
     JtJ.diagonal() *= 1.0 + 1e-9;
     JtJ.diagonal().array() += 1e-12;
     const Motion delta = JtJ.ldlt().solve(-Jtr);
@@ -69,6 +82,36 @@ Motion Refine(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
     if (delta.norm() < 1e-7) break;
   }
   return m;
+}
+
+// The standard error of the camera's turn across the inliers' mean pair
+// (their mean c, d, e: about one frame interval) [px at the focal length],
+// its largest direction: sigma^2 J (JtJ)^-1 J^T with the inliers' residual
+// sigma, at least kMinSigmaPx.
+double TurnSigmaPx(const std::vector<BearingPair>& pairs,
+                   const std::vector<int>& in, const Motion& m,
+                   const MotionPrior& prior, double rms_px) {
+  constexpr double kMinSigmaPx = 0.25;  // a residual this small is luck
+  Matrix9 JtJ;
+  Motion Jtr;
+  NormalEquations(pairs, in, m, prior, &JtJ, &Jtr);
+  double c = 0.0, d = 0.0, e = 0.0;
+  for (int i : in) {
+    c += pairs[i].c / in.size();
+    d += pairs[i].d / in.size();
+    e += pairs[i].e / in.size();
+  }
+  Eigen::Matrix<double, 3, 9> J;
+  J << c * Eigen::Matrix3d::Identity(), d * Eigen::Matrix3d::Identity(),
+      e * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix<double, 9, 3> X = JtJ.ldlt().solve(J.transpose());
+  const Eigen::Matrix3d cov = J * X;
+  const double sigma = std::max(rms_px, kMinSigmaPx);
+  const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov)
+                             .eigenvalues()
+                             .maxCoeff();
+  const double s = sigma * std::sqrt(std::max(largest, 0.0));
+  return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
@@ -151,6 +194,7 @@ bool FitMotion(const std::vector<BearingPair>& pairs, const std::vector<double>&
   fit->inliers = best;
   fit->rms_px = std::sqrt(ss / best.size());
   fit->support = support(best) / total;
+  fit->turn_sigma_px = TurnSigmaPx(pairs, best, best_m, prior, fit->rms_px);
   return true;
 }
 

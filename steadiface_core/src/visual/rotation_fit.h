@@ -44,6 +44,10 @@ struct RotationFit {
   std::vector<int> inliers;  // indices into the pairs
   double rms_px = 0.0;       // inliers' reprojection error
   double support = 0.0;      // the inliers' share of the summed weight
+  /// The standard error of the camera's turn across one pair, in its worst
+  /// direction, from the inliers' spread and residual [px at the focal
+  /// length]: how far the fit alone may be off.
+  double turn_sigma_px = 0.0;
 };
 
 /// RANSAC over triples of features (each triple's motion by Gauss-Newton

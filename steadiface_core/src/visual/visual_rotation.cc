@@ -36,9 +36,15 @@ Status ValidateVisualRotationOptions(const VisualRotationOptions& o) {
   } else if (o.ransac_iterations < 1 || o.ransac_iterations > 10000) {
     err << "visual.ransac_iterations must be in [1, 10000], got "
         << o.ransac_iterations;
-  } else if (o.min_inliers < 2 || o.min_inliers > o.max_features) {
-    err << "visual.min_inliers must be in [2, max_features], got "
-        << o.min_inliers;
+  } else if (o.min_inliers_precise < 3 ||
+             o.min_inliers_precise > o.min_inliers ||
+             o.min_inliers > o.max_features) {
+    err << "visual: need 3 <= min_inliers_precise <= min_inliers <= "
+           "max_features, got "
+        << o.min_inliers_precise << " / " << o.min_inliers;
+  } else if (!(o.max_turn_error_px > 0.0 && o.max_turn_error_px <= 100.0)) {
+    err << "visual.max_turn_error_px must be in (0, 100], got "
+        << o.max_turn_error_px;
   } else if (!(o.min_inlier_ratio >= 0.0 && o.min_inlier_ratio <= 1.0)) {
     err << "visual.min_inlier_ratio must be in [0, 1], got "
         << o.min_inlier_ratio;
@@ -214,7 +220,13 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
   out->inliers = static_cast<int>(fit.inliers.size());
   out->residual_px = fit.rms_px;
   out->support = fit.support;
-  out->valid = out->inliers >= options_.min_inliers && fit.support >= options_.min_inlier_ratio;
+  out->turn_error_px = fit.turn_sigma_px;
+  // Many inliers are trusted; a few only when they pin the turn down
+  // (VisualRotationOptions::min_inliers_precise).
+  const bool enough = out->inliers >= options_.min_inliers ||
+                      (out->inliers >= options_.min_inliers_precise &&
+                       fit.turn_sigma_px <= options_.max_turn_error_px);
+  out->valid = enough && fit.support >= options_.min_inlier_ratio;
   if (!out->valid) return;  // not trusted: every track is kept as it was
   out->omega = fit.motion.head<3>();
   out->alpha = fit.motion.segment<3>(3);
