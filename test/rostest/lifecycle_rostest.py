@@ -107,7 +107,7 @@ class LifecycleTest(unittest.TestCase):
             self.assertTrue(r.success, "cycle %d: load failed" % i)
             # Frames must come out of this instance before it is unloaded
             # (the bag loops every few seconds and the node resets on it).
-            frames.wait_for(n0 + ARGS.frames_per_cycle, 12.0, 4.0)
+            frames.wait_for(n0 + ARGS.frames_per_cycle, 10.0, 4.0)
             got = frames.value() - n0
             self.assertGreaterEqual(got, ARGS.frames_per_cycle,
                                     "cycle %d: only %d stabilized frames after load" % (i, got))
