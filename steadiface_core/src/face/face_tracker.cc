@@ -25,6 +25,13 @@ namespace {
 constexpr double kTurnMemoryRadPerS = 0.3;
 // While a head is followed, the detector runs on one frame in this many.
 constexpr int kFollowRedetectFrames = 3;
+// A covered face's followed region reaches this share of the face box's
+// height above it (forehead and hair) [-].
+constexpr double kCoveredRegionUp = 0.4;
+// ... and is measured from this many agreeing tracks: a hand leaves a strip
+// of the face in view, and its tracks agree within 0.1 px on the
+// simulator's hand (face_tracker_test) [-].
+constexpr int kCoveredMinInliers = 6;
 }  // namespace
 
 Status FaceTracker::Create(const CameraModel& model,
@@ -61,6 +68,7 @@ void FaceTracker::Reset() {
   reference_yaw_ = 0.0;
   region_motion_.Clear();
   following_ = false;
+  have_own_shift_ = false;
   have_last_frame_ = false;
   fitted_last_frame_ = false;
   have_fitted_pose_ = false;
@@ -300,6 +308,7 @@ void FaceTracker::Search(const cv::Mat& gray, const SearchStep& step, Time stamp
   }
   if (ok) {
     Accept(c, true, patch, stamp, info);
+    have_own_shift_ = false;
     region_motion_.Remember(gray, BoxFromLandmarks(c.landmarks));
   } else {
     MarkFailure(faces.empty() ? FaceFailure::kNoFace : info->failure, stamp, info);
@@ -371,6 +380,10 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
     info->failure = FaceFailure::kOutOfFrame;
   }
   if (ok) {
+    // The head's own motion, for the follow's gate: the centre against
+    // where the camera's rotation alone would have put it.
+    have_own_shift_ = fitted_last_frame_ || following_;
+    own_shift_ = Mean(c.landmarks) - pc;
     Accept(c, false, patch, stamp, info);
     region_motion_.Remember(gray, BoxFromLandmarks(c.landmarks));
     return;
@@ -384,31 +397,52 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
   if (rot_ok) last_landmarks_ = predicted;
 }
 
+bool FaceTracker::StartFollow(Time stamp, double scale) {
+  // A face last fitted turned away whose landmarks now fail has most
+  // likely turned past what the landmark model fits; its head is still in
+  // view, and is followed as a turning cylinder (face/head_turn.h). A face
+  // that fails while facing the camera is covered (a hand) or blurred; the
+  // visible parts of its region still move with the head, and it is
+  // followed by their translation, briefly, while they continue the head's
+  // own motion (Follow's gate), so the tracker never follows the cover.
+  const double since_fit = ToSeconds(stamp - last_seen_);
+  const bool turned = options_.follow_turned_s > 0.0 && have_fitted_pose_ &&
+                      recent_abs_yaw_ >= options_.follow_min_yaw_rad &&
+                      since_fit <= options_.follow_turned_s;
+  const bool covered = options_.follow_covered_s > 0.0 && have_own_shift_ &&
+                       (!have_fitted_pose_ || recent_abs_yaw_ < options_.follow_min_yaw_rad) &&
+                       since_fit <= options_.follow_covered_s;
+  if (following_) {
+    if (following_covered_ ? covered : turned) return true;
+  } else if (turned || covered) {
+    following_covered_ = !turned;
+    // The axis from the last fit: behind the landmark centre by the pivot
+    // (a covered face: at its centre, followed by its translation).
+    const double depth = following_covered_ ? 0.0 : options_.head_pivot_depth;
+    head_turn_ = HeadTurn();
+    head_turn_.radius_px = depth * scale;
+    head_turn_.yaw = depth > 0.0 ? fitted_yaw_ : 0.0;
+    head_turn_.yaw_rate = depth > 0.0 ? fitted_yaw_rate_ : 0.0;
+    head_turn_.axis_px =
+        Mean(last_landmarks_) + Eigen::Vector2d(head_turn_.radius_px * std::sin(head_turn_.yaw), 0);
+    return true;
+  }
+  following_ = false;
+  have_own_shift_ = false;
+  return false;
+}
+
 bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d& pc,
                          const OrientationTimeline* timeline, const RowTiming* timing,
                          FaceInfo* info) {
-  // A face last fitted turned away whose landmarks now fail has most
-  // likely turned past what the landmark model fits; its head is still in
-  // view, and is followed as a turning cylinder (face/head_turn.h) within
-  // the gyro gate. A face lost while facing the camera (a hand, someone
-  // passing) is not followed, so the tracker never follows what covers it.
-  if (!(options_.follow_turned_s > 0.0) || !have_fitted_pose_ || !region_motion_.ready() ||
-      recent_abs_yaw_ < options_.follow_min_yaw_rad || fitted_landmarks_.empty() ||
-      ToSeconds(stamp - last_seen_) > options_.follow_turned_s) {
+  if (!region_motion_.ready() || fitted_landmarks_.empty()) {
     following_ = false;
+    have_own_shift_ = false;
     return false;
   }
   const Eigen::Vector2d fitted_centre = Mean(fitted_landmarks_);
   const double scale = RmsRadius(fitted_landmarks_, fitted_centre);
-  if (!following_) {
-    // The axis from the last fit: behind the landmark centre by the pivot.
-    head_turn_ = HeadTurn();
-    head_turn_.radius_px = options_.head_pivot_depth * scale;
-    head_turn_.yaw = options_.head_pivot_depth > 0.0 ? fitted_yaw_ : 0.0;
-    head_turn_.yaw_rate = options_.head_pivot_depth > 0.0 ? fitted_yaw_rate_ : 0.0;
-    head_turn_.axis_px =
-        Mean(last_landmarks_) + Eigen::Vector2d(head_turn_.radius_px * std::sin(head_turn_.yaw), 0);
-  }
+  if (!(scale > 0.0) || !StartFollow(stamp, scale)) return false;
   // The head's own motion: the tracks beyond the camera's rotation; the
   // axis then moves by both.
   const HeadRegionMotion::CameraShift camera = [&](const Eigen::Vector2d& p) {
@@ -417,27 +451,40 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
   RegionFlow flow;
   HeadTurn next = head_turn_;
   const Eigen::Vector2d camera_at_axis = camera(next.axis_px);
-  const bool moved = region_motion_.Track(gray, &flow, camera) &&
-                     (next.radius_px > 0.0 ? UpdateHeadTurn(flow, &next)
-                                           : (next.axis_px += flow.mean_shift, true));
+  const int min_inliers =
+      following_covered_ ? std::min(kCoveredMinInliers, options_.region_motion.min_inliers) : 0;
+  bool moved = region_motion_.Track(gray, &flow, camera, min_inliers) &&
+               (next.radius_px > 0.0 ? UpdateHeadTurn(flow, &next)
+                                     : (next.axis_px += flow.mean_shift, true));
+  // The region must move on as the head did: a median that does not is a
+  // cover's motion (a hand that dragged the last landmarks into a turn, too).
+  const double gate = std::max(2.0, options_.follow_max_speed_change * scale);
+  if (have_own_shift_ && (flow.mean_shift - own_shift_).norm() > gate) moved = false;
   next.axis_px += camera_at_axis;
   const Eigen::Vector2d centre = next.FaceCentre();
-  if (!moved || !(scale > 0.0) || (centre - pc).norm() > options_.max_jump * scale) {
+  if (!moved || (centre - pc).norm() > options_.max_jump * scale) {
     following_ = false;
+    have_own_shift_ = false;
     return false;
   }
   std::vector<Eigen::Vector2d> lm = fitted_landmarks_;
   for (auto& p : lm) p += centre - fitted_centre;
   // The region followed next: the head about its axis, the face's rows.
   const cv::Rect2d face = BoxFromLandmarks(lm);
+  // A covered face's region reaches up over the forehead and hair, which
+  // a hand over the face mostly leaves in view.
   const double half = next.radius_px > 0.0 ? 0.9 * next.radius_px : 0.5 * face.width;
-  const cv::Rect2d head(next.axis_px.x() - half, face.y, 2.0 * half, face.height);
+  const double up = following_covered_ ? kCoveredRegionUp * face.height : 0.0;
+  const cv::Rect2d head(next.axis_px.x() - half, face.y - up, 2.0 * half, face.height + up);
   if ((head & cv::Rect2d(0, 0, gray.cols, gray.rows)).area() < 0.5 * head.area()) {
     following_ = false;
+    have_own_shift_ = false;
     return false;
   }
   following_ = true;
   head_turn_ = next;
+  own_shift_ = flow.mean_shift;
+  have_own_shift_ = true;
   last_landmarks_ = lm;
   last_located_ = stamp;
   region_motion_.Remember(gray, head);

@@ -42,6 +42,11 @@ Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
     err << "face.relock_yaw_step_rad must be in [0, 1], got " << o.relock_yaw_step_rad;
   } else if (!(o.follow_turned_s >= 0.0 && o.follow_turned_s <= 60.0)) {
     err << "face.follow_turned must be in [0, 60] s, got " << o.follow_turned_s;
+  } else if (!(o.follow_covered_s >= 0.0 && o.follow_covered_s <= 10.0)) {
+    err << "face.follow_covered must be in [0, 10] s, got " << o.follow_covered_s;
+  } else if (!(o.follow_max_speed_change > 0.0 && o.follow_max_speed_change <= 10.0)) {
+    err << "face.follow_max_speed_change must be in (0, 10] face scales per frame, got "
+        << o.follow_max_speed_change;
   } else if (!(o.follow_min_yaw_rad >= 0.0 && o.follow_min_yaw_rad <= 1.6)) {
     err << "face.follow_min_yaw must be in [0, 1.6] rad, got " << o.follow_min_yaw_rad;
   } else if (!(o.head_pivot_depth >= 0.0 && o.head_pivot_depth <= 10.0)) {

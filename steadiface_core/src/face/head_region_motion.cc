@@ -57,9 +57,10 @@ void HeadRegionMotion::Remember(const cv::Mat& grey, const cv::Rect2d& region) {
   region_ = region;
 }
 
-bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow,
-                             const CameraShift& camera) const {
+bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow, const CameraShift& camera,
+                             int min_inliers) const {
   const HeadRegionMotionOptions& o = options_;
+  const int min_n = min_inliers > 0 ? min_inliers : o.min_inliers;
   if (crop_.empty() || grey.empty() || grey.type() != CV_8UC1) return false;
   // Corners inside the region's ellipse (the head, not the corners of its
   // box, where the background shows).
@@ -71,9 +72,9 @@ bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow,
               cv::Size(cvRound(0.5 * region_.width * k), cvRound(0.5 * region_.height * k)), 0.0,
               0.0, 360.0, cv::Scalar(255), cv::FILLED);
   std::vector<cv::Point2f> p0;
-  const double spacing = std::max(3.0, region_.width * k / 12.0);
+  const double spacing = std::max(3.0, region_.width * k / 20.0);
   cv::goodFeaturesToTrack(crop_, p0, o.max_features, 0.01, spacing, mask);
-  if (static_cast<int>(p0.size()) < o.min_inliers) return false;
+  if (static_cast<int>(p0.size()) < min_n) return false;
   // This frame cut where the remembered crop was, at its scale.
   if ((cut_ & cv::Rect(0, 0, grey.cols, grey.rows)) != cut_) return false;
   cv::Mat now;
@@ -103,7 +104,7 @@ bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow,
                    (camera ? camera(start) : Eigen::Vector2d::Zero()));
     from.push_back(start);
   }
-  if (static_cast<int>(d.size()) < o.min_inliers) return false;
+  if (static_cast<int>(d.size()) < min_n) return false;
   std::vector<double> dx, dy;
   for (const auto& v : d) {
     dx.push_back(v.x());
@@ -120,7 +121,7 @@ bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow,
     f.shift.push_back(d[i]);
   }
   const int n = static_cast<int>(f.shift.size());
-  if (n < o.min_inliers || 2 * n < static_cast<int>(d.size())) return false;
+  if (n < min_n || 2 * n < static_cast<int>(d.size())) return false;
   f.mean_shift = sum / n;
   f.inlier_share = n / static_cast<double>(d.size());
   if (!f.mean_shift.allFinite()) return false;

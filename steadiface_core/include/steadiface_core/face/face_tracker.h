@@ -88,6 +88,19 @@ struct FaceTrackerOptions {
   /// last fits, forgotten at 0.3 rad/s (a face lost while facing the camera
   /// is covered or gone, and is held, not followed) [rad].
   double follow_min_yaw_rad = 0.3;
+  /// A locked face whose landmarks fail while it faces the camera (a hand
+  /// over part of it, or blur) is followed by the translation of the head
+  /// region's visible parts (HeadRegionMotion's median track, beyond the
+  /// camera's rotation) for at most this long after the last fit; the
+  /// parts the cover hides fail their tracks, and a median that does not
+  /// continue the head's own motion (follow_max_speed_change) is the
+  /// cover's, so the face is then held. 0 = off: held from the first
+  /// failed frame [s].
+  double follow_covered_s = 0.5;
+  /// ... a covered face's region moves on with the head's own motion of
+  /// the frame before within this many face scales (RMS landmark radius)
+  /// per frame, and at least 2 px [-].
+  double follow_max_speed_change = 0.15;
   /// How the head region's motion is measured.
   HeadRegionMotionOptions region_motion;
   /// The followed head turns about an axis this far behind its landmarks,
@@ -167,10 +180,14 @@ class FaceTracker {
   // Takes the references again from an accepted face turned nearer the
   // camera than they were (options_.relock_yaw_step_rad).
   void Relock(const Candidate& c, bool acquiring, const cv::Mat& patch, const FaceInfo& info);
-  // A turned face whose landmarks failed: its last landmarks moved with
-  // the head region (options_.follow_turned_s); false when not followed.
+  // A face whose landmarks failed, turned (options_.follow_turned_s) or
+  // covered (options_.follow_covered_s): its last landmarks moved with the
+  // head region; false when not followed.
   bool Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d& predicted_centre,
               const OrientationTimeline* timeline, const RowTiming* timing, FaceInfo* info);
+  // Follow's choice: false when neither kind of follow applies; the head
+  // model is set up on the first followed frame.
+  bool StartFollow(Time stamp, double scale);
   // Where the camera's rotation moves a still point from the previous
   // frame's pixel into this frame's (face_prediction.cc); zero without the
   // gyro.
@@ -215,7 +232,12 @@ class FaceTracker {
   double reference_yaw_ = 0.0;                   // |yaw| of the references [rad]
   HeadRegionMotion region_motion_;               // the head's crop, for Follow
   bool following_ = false;                       // Follow's state:
+  bool following_covered_ = false;               // ... by translation only
   HeadTurn head_turn_;                           // the followed head
+  // The head's own motion over the last frame, beyond the camera's
+  // rotation, when it was located in both frames [px/frame].
+  Eigen::Vector2d own_shift_ = Eigen::Vector2d::Zero();
+  bool have_own_shift_ = false;
   std::vector<Eigen::Vector2d> fitted_landmarks_;  // the last fit's
   bool have_fitted_pose_ = false;                // the last fit's pose:
   double fitted_yaw_ = 0.0, fitted_pitch_ = 0.0, fitted_roll_ = 0.0;  // [rad]

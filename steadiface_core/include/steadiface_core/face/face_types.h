@@ -58,9 +58,11 @@ struct FaceInfo {
   /// True when `landmarks_*` hold this frame's validated landmarks.
   bool valid = false;
   /// True when the landmarks failed (`failure` says why) but the head,
-  /// last seen turned away, was followed by its image motion: `landmarks_*`
-  /// hold the last fitted landmarks moved with it, a position and not a
-  /// fit, and the pose is the last fit's (FaceTrackerOptions::follow_turned_s).
+  /// last seen turned away or partly covered, was followed by its image
+  /// motion: `landmarks_*` hold the last fitted landmarks moved with it, a
+  /// position and not a fit; the pose is the followed turn's, or a covered
+  /// face's last fit's (FaceTrackerOptions::follow_turned_s,
+  /// follow_covered_s).
   bool followed = false;
   /// Detection ran this frame (acquisition, periodic or after a failure).
   bool detected = false;

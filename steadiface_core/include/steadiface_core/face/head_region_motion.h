@@ -62,8 +62,9 @@ class HeadRegionMotion {
   /// beyond the camera's rotation (rolling shutter included), so that the
   /// flow is the region's own motion. False when there is no remembered
   /// region or fewer than min_inliers tracks agree (or under half of those
-  /// tracked).
-  bool Track(const cv::Mat& grey, RegionFlow* flow, const CameraShift& camera = {}) const;
+  /// tracked). `min_inliers` > 0 replaces the options' for this call.
+  bool Track(const cv::Mat& grey, RegionFlow* flow, const CameraShift& camera = {},
+             int min_inliers = 0) const;
   void Clear();
   bool ready() const { return !crop_.empty(); }
 
