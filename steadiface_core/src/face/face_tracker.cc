@@ -307,12 +307,22 @@ void FaceTracker::Search(const cv::Mat& gray, const SearchStep& step, Time stamp
     }
   }
   if (ok) {
-    Accept(c, true, patch, stamp, info);
-    have_own_shift_ = false;
-    region_motion_.Remember(gray, BoxFromLandmarks(c.landmarks));
+    TakeFit(gray, c, true, patch, nullptr, stamp, info);
   } else {
     MarkFailure(faces.empty() ? FaceFailure::kNoFace : info->failure, stamp, info);
   }
+}
+
+void FaceTracker::TakeFit(const cv::Mat& gray, const Candidate& c, bool acquiring,
+                          const cv::Mat& patch, const Eigen::Vector2d* predicted_centre,
+                          Time stamp, FaceInfo* info) {
+  // The head's own motion, for the follow's gate: the centre against where
+  // the camera's rotation alone would have put it, when the face was
+  // located in the frame before too.
+  have_own_shift_ = predicted_centre != nullptr && (fitted_last_frame_ || following_);
+  if (have_own_shift_) own_shift_ = Mean(c.landmarks) - *predicted_centre;
+  Accept(c, acquiring, patch, stamp, info);
+  region_motion_.Remember(gray, BoxFromLandmarks(c.landmarks));
 }
 
 void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
@@ -380,12 +390,7 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
     info->failure = FaceFailure::kOutOfFrame;
   }
   if (ok) {
-    // The head's own motion, for the follow's gate: the centre against
-    // where the camera's rotation alone would have put it.
-    have_own_shift_ = fitted_last_frame_ || following_;
-    own_shift_ = Mean(c.landmarks) - pc;
-    Accept(c, false, patch, stamp, info);
-    region_motion_.Remember(gray, BoxFromLandmarks(c.landmarks));
+    TakeFit(gray, c, false, patch, &pc, stamp, info);
     return;
   }
   MarkFailure(info->failure == FaceFailure::kNone ? FaceFailure::kNoFace : info->failure,
@@ -427,6 +432,10 @@ bool FaceTracker::StartFollow(Time stamp, double scale) {
         Mean(last_landmarks_) + Eigen::Vector2d(head_turn_.radius_px * std::sin(head_turn_.yaw), 0);
     return true;
   }
+  return StopFollowing();
+}
+
+bool FaceTracker::StopFollowing() {
   following_ = false;
   have_own_shift_ = false;
   return false;
@@ -436,9 +445,7 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
                          const OrientationTimeline* timeline, const RowTiming* timing,
                          FaceInfo* info) {
   if (!region_motion_.ready() || fitted_landmarks_.empty()) {
-    following_ = false;
-    have_own_shift_ = false;
-    return false;
+    return StopFollowing();
   }
   const Eigen::Vector2d fitted_centre = Mean(fitted_landmarks_);
   const double scale = RmsRadius(fitted_landmarks_, fitted_centre);
@@ -463,9 +470,7 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
   next.axis_px += camera_at_axis;
   const Eigen::Vector2d centre = next.FaceCentre();
   if (!moved || (centre - pc).norm() > options_.max_jump * scale) {
-    following_ = false;
-    have_own_shift_ = false;
-    return false;
+    return StopFollowing();
   }
   std::vector<Eigen::Vector2d> lm = fitted_landmarks_;
   for (auto& p : lm) p += centre - fitted_centre;
@@ -477,9 +482,7 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
   const double up = following_covered_ ? kCoveredRegionUp * face.height : 0.0;
   const cv::Rect2d head(next.axis_px.x() - half, face.y - up, 2.0 * half, face.height + up);
   if ((head & cv::Rect2d(0, 0, gray.cols, gray.rows)).area() < 0.5 * head.area()) {
-    following_ = false;
-    have_own_shift_ = false;
-    return false;
+    return StopFollowing();
   }
   following_ = true;
   head_turn_ = next;

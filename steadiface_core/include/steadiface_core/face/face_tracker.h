@@ -97,9 +97,10 @@ struct FaceTrackerOptions {
   /// cover's, so the face is then held. 0 = off: held from the first
   /// failed frame [s].
   double follow_covered_s = 0.5;
-  /// ... a covered face's region moves on with the head's own motion of
-  /// the frame before within this many face scales (RMS landmark radius)
-  /// per frame, and at least 2 px [-].
+  /// ... and every followed frame, covered or turned, must move on with
+  /// the head's own motion of the frame before within this many face
+  /// scales (RMS landmark radius) per frame, and at least 2 px; else the
+  /// face is held [-].
   double follow_max_speed_change = 0.15;
   /// How the head region's motion is measured.
   HeadRegionMotionOptions region_motion;
@@ -177,6 +178,12 @@ class FaceTracker {
                               int* n_scores) const;
   void Accept(const Candidate& c, bool acquiring, const cv::Mat& patch,
               Time stamp, FaceInfo* info);
+  // Accept, the head's own motion since the frame before when
+  // `predicted_centre` (where the camera's rotation alone moved the face)
+  // is given and the face was located then, and the region Follow tracks
+  // from.
+  void TakeFit(const cv::Mat& gray, const Candidate& c, bool acquiring, const cv::Mat& patch,
+               const Eigen::Vector2d* predicted_centre, Time stamp, FaceInfo* info);
   // Takes the references again from an accepted face turned nearer the
   // camera than they were (options_.relock_yaw_step_rad).
   void Relock(const Candidate& c, bool acquiring, const cv::Mat& patch, const FaceInfo& info);
@@ -188,6 +195,8 @@ class FaceTracker {
   // Follow's choice: false when neither kind of follow applies; the head
   // model is set up on the first followed frame.
   bool StartFollow(Time stamp, double scale);
+  // Ends a follow (and the head's own motion it carried); returns false.
+  bool StopFollowing();
   // Where the camera's rotation moves a still point from the previous
   // frame's pixel into this frame's (face_prediction.cc); zero without the
   // gyro.
