@@ -30,8 +30,24 @@ double Median(std::vector<double> v) {
 }  // namespace
 
 void HeadRegionMotion::Clear() {
+  cut_pixels_.release();
   crop_.release();
   region_ = cv::Rect2d();
+}
+
+const cv::Mat& HeadRegionMotion::Crop() const {
+  // Scaled on first use only: most remembered regions are never tracked
+  // (the landmarks fit the next frame), and scaling a large head's crop
+  // costs more than copying it.
+  if (crop_.empty() && !cut_pixels_.empty()) {
+    const cv::Size size(cvRound(cut_.width * scale_), cvRound(cut_.height * scale_));
+    if (scale_ < 1.0) {
+      cv::resize(cut_pixels_, crop_, size, 0, 0, cv::INTER_AREA);
+    } else {
+      crop_ = cut_pixels_;
+    }
+  }
+  return crop_;
 }
 
 void HeadRegionMotion::Remember(const cv::Mat& grey, const cv::Rect2d& region) {
@@ -48,11 +64,7 @@ void HeadRegionMotion::Remember(const cv::Mat& grey, const cv::Rect2d& region) {
   scale_ = std::min(1.0, options_.max_region_px / region.width);
   const cv::Size size(cvRound(c.width * scale_), cvRound(c.height * scale_));
   if (size.width < 16 || size.height < 16) return;
-  if (scale_ < 1.0) {
-    cv::resize(grey(c), crop_, size, 0, 0, cv::INTER_AREA);
-  } else {
-    grey(c).copyTo(crop_);
-  }
+  grey(c).copyTo(cut_pixels_);
   cut_ = c;
   region_ = region;
 }
@@ -61,11 +73,12 @@ bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow, const Camera
                              int min_inliers) const {
   const HeadRegionMotionOptions& o = options_;
   const int min_n = min_inliers > 0 ? min_inliers : o.min_inliers;
-  if (crop_.empty() || grey.empty() || grey.type() != CV_8UC1) return false;
+  if (cut_pixels_.empty() || grey.empty() || grey.type() != CV_8UC1) return false;
+  const cv::Mat& crop = Crop();
   // Corners inside the region's ellipse (the head, not the corners of its
   // box, where the background shows).
   const double k = scale_;
-  cv::Mat mask = cv::Mat::zeros(crop_.size(), CV_8U);
+  cv::Mat mask = cv::Mat::zeros(crop.size(), CV_8U);
   const cv::Point2d centre((region_.x + 0.5 * region_.width - cut_.x) * k,
                            (region_.y + 0.5 * region_.height - cut_.y) * k);
   cv::ellipse(mask, cv::Point(cvRound(centre.x), cvRound(centre.y)),
@@ -73,13 +86,13 @@ bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow, const Camera
               0.0, 360.0, cv::Scalar(255), cv::FILLED);
   std::vector<cv::Point2f> p0;
   const double spacing = std::max(3.0, region_.width * k / 20.0);
-  cv::goodFeaturesToTrack(crop_, p0, o.max_features, 0.01, spacing, mask);
+  cv::goodFeaturesToTrack(crop, p0, o.max_features, 0.01, spacing, mask);
   if (static_cast<int>(p0.size()) < min_n) return false;
   // This frame cut where the remembered crop was, at its scale.
   if ((cut_ & cv::Rect(0, 0, grey.cols, grey.rows)) != cut_) return false;
   cv::Mat now;
   if (k < 1.0) {
-    cv::resize(grey(cut_), now, crop_.size(), 0, 0, cv::INTER_AREA);
+    cv::resize(grey(cut_), now, crop.size(), 0, 0, cv::INTER_AREA);
   } else {
     now = grey(cut_);
   }
@@ -89,9 +102,9 @@ bool HeadRegionMotion::Track(const cv::Mat& grey, RegionFlow* flow, const Camera
   std::vector<float> err;
   const cv::Size win(15, 15);
   const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
-  cv::calcOpticalFlowPyrLK(crop_, now, p0, p1, ok1, err, win, 3, term,
+  cv::calcOpticalFlowPyrLK(crop, now, p0, p1, ok1, err, win, 3, term,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
-  cv::calcOpticalFlowPyrLK(now, crop_, p1, back, ok2, err, win, 3, term,
+  cv::calcOpticalFlowPyrLK(now, crop, p1, back, ok2, err, win, 3, term,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
   std::vector<Eigen::Vector2d> d, from;
   for (size_t i = 0; i < p0.size(); ++i) {

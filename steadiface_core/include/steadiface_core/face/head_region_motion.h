@@ -66,11 +66,15 @@ class HeadRegionMotion {
   bool Track(const cv::Mat& grey, RegionFlow* flow, const CameraShift& camera = {},
              int min_inliers = 0) const;
   void Clear();
-  bool ready() const { return !crop_.empty(); }
+  bool ready() const { return !cut_pixels_.empty(); }
 
  private:
+  // cut_pixels_ scaled by scale_ (computed on the first Track).
+  const cv::Mat& Crop() const;
+
   const HeadRegionMotionOptions options_;
-  cv::Mat crop_;                  // grey around region_, scaled by scale_
+  cv::Mat cut_pixels_;            // grey around region_, as cut from the frame
+  mutable cv::Mat crop_;          // ... scaled by scale_ (Crop)
   cv::Rect cut_;                  // where crop_ was cut from the frame [px]
   double scale_ = 1.0;            // crop_ px per frame px
   cv::Rect2d region_;             // the region in the frame [px]
