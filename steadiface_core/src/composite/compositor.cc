@@ -4,6 +4,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "composite/row_stripes.h"
+
 namespace steadiface {
 namespace {
 
@@ -161,71 +163,84 @@ void Compositor::FillUncovered(const cv::Mat& subject, cv::Mat* out) {
   // Where the background layer shows the subject (m_b) and the subject
   // layer does not (1 - m_s), the plate (freshness v), else the fallback.
   const cv::Rect& rb = report_.background_roi;
-  const cv::Rect& rs = report_.subject_roi;
-  const int cn = out->channels();
   if (keep_plate_) {
     plate_weight_ = cv::Mat::zeros(rb.size(), CV_32F);
     plate_sample_ = cv::Mat::zeros(rb.size(), out->type());
   }
+  double uncovered[composite_internal::kRowStripes] = {};
+  double filled[composite_internal::kRowStripes] = {};
+  composite_internal::ForRowStripes(rb.height, [&](int k, int y0, int y1) {
+    for (int y = y0; y < y1; ++y) FillRow(subject, y, &uncovered[k], &filled[k], out);
+  });
+  double all = 0.0, plate = 0.0;
+  for (int k = 0; k < composite_internal::kRowStripes; ++k) all += uncovered[k], plate += filled[k];
+  report_.matte_mean = cv::sum(matte_b8_)[0] / 255.0 / std::max(1, rb.area());
+  report_.uncovered_px = all;
+  report_.plate_share = all > 0.0 ? plate / all : 0.0;
+  report_.fallback_share = all > 0.0 ? 1.0 - report_.plate_share : 0.0;
+}
+
+void Compositor::FillRow(const cv::Mat& subject, int y, double* uncovered, double* filled,
+                         cv::Mat* out) {
+  const cv::Rect& rb = report_.background_roi;
+  const cv::Rect& rs = report_.subject_roi;
+  const int cn = out->channels();
   const Eigen::Matrix3d& G = plate_.view_to_plate();
   uchar scratch[4];
-  double uncovered = 0.0, filled = 0.0;
-  for (int y = 0; y < rb.height; ++y) {
-    const int Y = rb.y + y;
-    const uchar* mb = matte_b8_.ptr<uchar>(y);
-    const uchar* S = subject.ptr<uchar>(Y) + cn * rb.x;
-    uchar* O = out->ptr<uchar>(Y) + cn * rb.x;
-    uchar* P = keep_plate_ ? plate_sample_.ptr<uchar>(y) : nullptr;
-    const bool in_s = Y >= rs.y && Y < rs.y + rs.height;
-    const uchar* ms = in_s ? matte_s_.ptr<uchar>(Y - rs.y) : nullptr;
-    float* w = keep_plate_ ? plate_weight_.ptr<float>(y) : nullptr;
-    // The plate pixel of the row's first output pixel, stepped along the row.
-    const Eigen::Vector3d q0 = G * Eigen::Vector3d(rb.x, Y, 1.0);
-    for (int x = 0; x < rb.width; ++x) {
-      if (mb[x] == 0) continue;
-      const int X = rb.x + x;
-      const float m = mb[x] * (1.0f / 255.0f);
-      const float m_s = in_s && X >= rs.x && X < rs.x + rs.width ? ms[X - rs.x] * (1.0f / 255.0f) : 0.0f;
-      // The subject covers it (Blend draws it), or what would show of the
-      // fill under it is negligible.
-      if (m * (1.0f - m_s) < kFillNone) continue;
-      uchar* p = P != nullptr ? P + cn * x : scratch;
-      const Eigen::Vector3d q = q0 + x * G.col(0);
-      const float v = plate_.SamplePlate(q.x() / q.z(), q.y() / q.z(), p);
-      uncovered += m * (1.0f - m_s);
-      filled += m * v * (1.0f - m_s);
-      if (w != nullptr) w[x] = m * v * (1.0f - m_s);
-      const float wp = m * v, wf = m * (1.0f - v);
-      for (int c = 0; c < cn; ++c) {
-        const float b = O[cn * x + c];
-        O[cn * x + c] = cv::saturate_cast<uchar>(b + wp * (p[c] - b) + wf * (S[cn * x + c] - b));
-      }
+  const int Y = rb.y + y;
+  const uchar* mb = matte_b8_.ptr<uchar>(y);
+  const uchar* S = subject.ptr<uchar>(Y) + cn * rb.x;
+  uchar* O = out->ptr<uchar>(Y) + cn * rb.x;
+  uchar* P = keep_plate_ ? plate_sample_.ptr<uchar>(y) : nullptr;
+  const bool in_s = Y >= rs.y && Y < rs.y + rs.height;
+  const uchar* ms = in_s ? matte_s_.ptr<uchar>(Y - rs.y) : nullptr;
+  float* w = keep_plate_ ? plate_weight_.ptr<float>(y) : nullptr;
+  // The plate pixel of the row's first output pixel, stepped along the row.
+  const Eigen::Vector3d q0 = G * Eigen::Vector3d(rb.x, Y, 1.0);
+  for (int x = 0; x < rb.width; ++x) {
+    if (mb[x] == 0) continue;
+    const int X = rb.x + x;
+    const float m = mb[x] * (1.0f / 255.0f);
+    const float m_s = in_s && X >= rs.x && X < rs.x + rs.width ? ms[X - rs.x] * (1.0f / 255.0f) : 0.0f;
+    // The subject covers it (Blend draws it), or what would show of the
+    // fill under it is negligible.
+    if (m * (1.0f - m_s) < kFillNone) continue;
+    uchar* p = P != nullptr ? P + cn * x : scratch;
+    const Eigen::Vector3d q = q0 + x * G.col(0);
+    const float v = plate_.SamplePlate(q.x() / q.z(), q.y() / q.z(), p);
+    *uncovered += m * (1.0f - m_s);
+    *filled += m * v * (1.0f - m_s);
+    if (w != nullptr) w[x] = m * v * (1.0f - m_s);
+    const float wp = m * v, wf = m * (1.0f - v);
+    for (int c = 0; c < cn; ++c) {
+      const float b = O[cn * x + c];
+      O[cn * x + c] = cv::saturate_cast<uchar>(b + wp * (p[c] - b) + wf * (S[cn * x + c] - b));
     }
   }
-  report_.matte_mean = cv::sum(matte_b8_)[0] / 255.0 / std::max(1, rb.area());
-  report_.uncovered_px = uncovered;
-  report_.plate_share = uncovered > 0.0 ? filled / uncovered : 0.0;
-  report_.fallback_share = uncovered > 0.0 ? 1.0 - report_.plate_share : 0.0;
 }
 
 void Compositor::Blend(const cv::Mat& subject, cv::Mat* out) {
   // out += m_s (S - out), in 1/256 steps; a whole subject pixel is copied.
   const cv::Rect& rs = report_.subject_roi;
   const int cn = out->channels();
-  for (int y = 0; y < rs.height; ++y) {
-    const uchar* m = matte_s_.ptr<uchar>(y);
-    const uchar* S = subject.ptr<uchar>(rs.y + y) + cn * rs.x;
-    uchar* O = out->ptr<uchar>(rs.y + y) + cn * rs.x;
-    for (int x = 0; x < rs.width; ++x) {
-      if (m[x] == 0) continue;
-      if (m[x] == 255) {
-        for (int c = cn * x; c < cn * (x + 1); ++c) O[c] = S[c];
-        continue;
+  composite_internal::ForRowStripes(rs.height, [&](int, int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const uchar* m = matte_s_.ptr<uchar>(y);
+      const uchar* S = subject.ptr<uchar>(rs.y + y) + cn * rs.x;
+      uchar* O = out->ptr<uchar>(rs.y + y) + cn * rs.x;
+      for (int x = 0; x < rs.width; ++x) {
+        if (m[x] == 0) continue;
+        if (m[x] == 255) {
+          for (int c = cn * x; c < cn * (x + 1); ++c) O[c] = S[c];
+          continue;
+        }
+        const int w = m[x] + (m[x] >> 7);  // 0..255 -> 0..256
+        for (int c = cn * x; c < cn * (x + 1); ++c) {
+          O[c] = static_cast<uchar>(O[c] + ((w * (S[c] - O[c]) + 128) >> 8));
+        }
       }
-      const int w = m[x] + (m[x] >> 7);  // 0..255 -> 0..256
-      for (int c = cn * x; c < cn * (x + 1); ++c) O[c] = static_cast<uchar>(O[c] + ((w * (S[c] - O[c]) + 128) >> 8));
     }
-  }
+  });
 }
 
 }  // namespace steadiface

@@ -8,6 +8,7 @@
 
 #include "steadiface_core/common/grey.h"
 #include "steadiface_core/composite/guided_filter.h"
+#include "composite/row_stripes.h"
 
 namespace steadiface {
 namespace {
@@ -206,36 +207,38 @@ void SubjectMatte::RefineEdges(const cv::Mat& picture, const cv::Rect& low_roi,
     u0[i] = std::max(0, std::min(mean_a.cols - 2, static_cast<int>(std::floor(u))));
     fu[i] = std::min(1.0f, std::max(0.0f, u - u0[i]));
   }
-  std::vector<float> a_row(mean_a.cols), b_row(mean_a.cols);
-  for (int Y = active.y; Y < active.y + active.height; ++Y) {
-    const int cy = Y / s - low_roi.y;
-    if (cy < 0 || cy >= edge.rows) continue;
-    const uchar* e = edge.ptr<uchar>(cy);
-    bool any = false;
-    for (int cx = 0; cx < edge.cols && !any; ++cx) any = e[cx] != 0;
-    if (!any) continue;
-    const float v = (Y + 0.5f) * inv - 0.5f - low_roi.y;
-    const int v0 = std::max(0, std::min(mean_a.rows - 2, static_cast<int>(std::floor(v))));
-    const float fv = std::min(1.0f, std::max(0.0f, v - v0));
-    for (int u = 0; u < mean_a.cols; ++u) {
-      a_row[u] = (1 - fv) * mean_a.at<float>(v0, u) + fv * mean_a.at<float>(v0 + 1, u);
-      b_row[u] = (1 - fv) * mean_b.at<float>(v0, u) + fv * mean_b.at<float>(v0 + 1, u);
+  composite_internal::ForRowStripes(active.height, [&](int, int y0, int y1) {
+    std::vector<float> a_row(mean_a.cols), b_row(mean_a.cols);
+    for (int Y = active.y + y0; Y < active.y + y1; ++Y) {
+      const int cy = Y / s - low_roi.y;
+      if (cy < 0 || cy >= edge.rows) continue;
+      const uchar* e = edge.ptr<uchar>(cy);
+      bool any = false;
+      for (int cx = 0; cx < edge.cols && !any; ++cx) any = e[cx] != 0;
+      if (!any) continue;
+      const float v = (Y + 0.5f) * inv - 0.5f - low_roi.y;
+      const int v0 = std::max(0, std::min(mean_a.rows - 2, static_cast<int>(std::floor(v))));
+      const float fv = std::min(1.0f, std::max(0.0f, v - v0));
+      for (int u = 0; u < mean_a.cols; ++u) {
+        a_row[u] = (1 - fv) * mean_a.at<float>(v0, u) + fv * mean_a.at<float>(v0 + 1, u);
+        b_row[u] = (1 - fv) * mean_b.at<float>(v0, u) + fv * mean_b.at<float>(v0 + 1, u);
+      }
+      const uchar* px = picture.ptr<uchar>(Y);
+      float* m = matte->ptr<float>(Y - active.y);
+      for (int i = 0; i < active.width; ++i) {
+        const int X = active.x + i, cx = X / s - low_roi.x;
+        if (cx < 0 || cx >= edge.cols || !e[cx]) continue;
+        const uchar* c = px + cn * X;
+        const float I = cn >= 3 ? (0.114f * c[0] + 0.587f * c[1] + 0.299f * c[2]) / 255.0f
+                                : c[0] / 255.0f;
+        const int k = u0[i];
+        const float f = fu[i];
+        const float a = (1 - f) * a_row[k] + f * a_row[k + 1];
+        const float b = (1 - f) * b_row[k] + f * b_row[k + 1];
+        m[i] = std::min(1.0f, std::max(0.0f, a * I + b));
+      }
     }
-    const uchar* px = picture.ptr<uchar>(Y);
-    float* m = matte->ptr<float>(Y - active.y);
-    for (int i = 0; i < active.width; ++i) {
-      const int X = active.x + i, cx = X / s - low_roi.x;
-      if (cx < 0 || cx >= edge.cols || !e[cx]) continue;
-      const uchar* c = px + cn * X;
-      const float I = cn >= 3 ? (0.114f * c[0] + 0.587f * c[1] + 0.299f * c[2]) / 255.0f
-                              : c[0] / 255.0f;
-      const int k = u0[i];
-      const float f = fu[i];
-      const float a = (1 - f) * a_row[k] + f * a_row[k + 1];
-      const float b = (1 - f) * b_row[k] + f * b_row[k + 1];
-      m[i] = std::min(1.0f, std::max(0.0f, a * I + b));
-    }
-  }
+  });
 }
 
 cv::Mat SubjectMatte::MotionEvidence(const MatteInputs& in, const LowRes& low) const {
@@ -320,53 +323,55 @@ void SubjectMatte::Evidence(const MatteInputs& in, const LowRes& low, const cv::
   const double search = o.search_jaw_widths * std::max(1.0, in.region.jaw_width);
   logodds->create(rl.size(), CV_32F);
   verified->create(rl.size(), CV_32F);
-  for (int y = 0; y < rl.height; ++y) {
-    float* L = logodds->ptr<float>(y);
-    float* V = verified->ptr<float>(y);
-    const uchar* col = low.colour.ptr<uchar>(y);
-    for (int x = 0; x < rl.width; ++x) {
-      const Eigen::Vector2d p((rl.x + x + 0.5) * s - 0.5, (rl.y + y + 0.5) * s - 0.5);
-      V[x] = 1.0f;
-      const double sd = in.region.SignedDistance(p);
-      if (sd > search) {
-        L[x] = -8.0f;
-        continue;
-      }
-      const float prior = PriorLogOdds(in.region, p, sd, o.prior_softness);
-      float l = prior;
-      if (plate) {
-        const uchar* pl = low.plate.ptr<uchar>(y) + cn * x;
-        float d = 0.0f;
-        for (int c = 0; c < cn; ++c) d += std::abs(col[cn * x + c] - pl[c]);
-        d /= cn;
-        const float v = low.plate_valid.at<float>(y, x);
-        const float level = static_cast<float>(o.plate_level);
-        l += v * Clamp((d - level) / (0.5f * level), -3.0f, 3.0f);
-      }
-      const float acc = accumulated.at<float>(y, x), now = lm.at<float>(y, x);
-      l += Clamp(acc, -4.0f, 4.0f);
-      if (has_previous_) {
-        const int px = static_cast<int>(std::lround(rl.x + x - shift.x())) - previous_low_roi_.x;
-        const int py = static_cast<int>(std::lround(rl.y + y - shift.y())) - previous_low_roi_.y;
-        if (px >= 0 && py >= 0 && px < previous_logodds_.cols && py < previous_logodds_.rows) {
-          l += static_cast<float>(o.temporal) * previous_logodds_.at<float>(py, px);
+  composite_internal::ForRowStripes(rl.height, [&](int, int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      float* L = logodds->ptr<float>(y);
+      float* V = verified->ptr<float>(y);
+      const uchar* col = low.colour.ptr<uchar>(y);
+      for (int x = 0; x < rl.width; ++x) {
+        const Eigen::Vector2d p((rl.x + x + 0.5) * s - 0.5, (rl.y + y + 0.5) * s - 0.5);
+        V[x] = 1.0f;
+        const double sd = in.region.SignedDistance(p);
+        if (sd > search) {
+          L[x] = -8.0f;
+          continue;
         }
+        const float prior = PriorLogOdds(in.region, p, sd, o.prior_softness);
+        float l = prior;
+        if (plate) {
+          const uchar* pl = low.plate.ptr<uchar>(y) + cn * x;
+          float d = 0.0f;
+          for (int c = 0; c < cn; ++c) d += std::abs(col[cn * x + c] - pl[c]);
+          d /= cn;
+          const float v = low.plate_valid.at<float>(y, x);
+          const float level = static_cast<float>(o.plate_level);
+          l += v * Clamp((d - level) / (0.5f * level), -3.0f, 3.0f);
+        }
+        const float acc = accumulated.at<float>(y, x), now = lm.at<float>(y, x);
+        l += Clamp(acc, -4.0f, 4.0f);
+        if (has_previous_) {
+          const int px = static_cast<int>(std::lround(rl.x + x - shift.x())) - previous_low_roi_.x;
+          const int py = static_cast<int>(std::lround(rl.y + y - shift.y())) - previous_low_roi_.y;
+          if (px >= 0 && py >= 0 && px < previous_logodds_.cols && py < previous_logodds_.rows) {
+            l += static_cast<float>(o.temporal) * previous_logodds_.at<float>(py, px);
+          }
+        }
+        l += static_cast<float>(o.colour_weight) * ColourLogRatio(col + cn * x, cn);
+        L[x] = Clamp(l, -8.0f, 8.0f);
+        // The plate (and the colour model's scene) may take a pixel only where
+        // the scene is known to be there: beyond the search, or seen standing
+        // still in the background layer while it moved in the subject layer,
+        // now and over the recent frames. A subject pixel the matte missed must
+        // not enter the plate, or the plate would then call it scene; the
+        // landmarks' region alone is no proof, a subject may reach beyond it.
+        // Or, where nothing moves (a plain wall), outside the landmarks'
+        // region and confidently the scene by all the evidence together.
+        const bool moved_as_scene = std::isfinite(now) && now <= -1.0f && acc <= -1.0f;
+        const bool confident = prior <= -1.0f && L[x] <= -static_cast<float>(o.plate_confidence);
+        V[x] = moved_as_scene || confident ? 1.0f : 0.0f;
       }
-      l += static_cast<float>(o.colour_weight) * ColourLogRatio(col + cn * x, cn);
-      L[x] = Clamp(l, -8.0f, 8.0f);
-      // The plate (and the colour model's scene) may take a pixel only where
-      // the scene is known to be there: beyond the search, or seen standing
-      // still in the background layer while it moved in the subject layer,
-      // now and over the recent frames. A subject pixel the matte missed must
-      // not enter the plate, or the plate would then call it scene; the
-      // landmarks' region alone is no proof, a subject may reach beyond it.
-      // Or, where nothing moves (a plain wall), outside the landmarks'
-      // region and confidently the scene by all the evidence together.
-      const bool moved_as_scene = std::isfinite(now) && now <= -1.0f && acc <= -1.0f;
-      const bool confident = prior <= -1.0f && L[x] <= -static_cast<float>(o.plate_confidence);
-      V[x] = moved_as_scene || confident ? 1.0f : 0.0f;
     }
-  }
+  });
 }
 
 float SubjectMatte::ColourLogRatio(const uchar* px, int cn) const {

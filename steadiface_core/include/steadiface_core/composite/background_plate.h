@@ -94,7 +94,8 @@ class BackgroundPlate {
   // Update's step over `width` plate pixels of row py from x0: each takes
   // the picture (`image`, over output rectangle `roi`) at the view pixel G
   // maps it to, where `matte` (1/255 steps, over `roi`) is below `below`,
-  // unless it is a fresh pixel's outlier.
+  // unless it is a fresh pixel's outlier. Writes plate row py only, so
+  // rows may run in parallel.
   void UpdateRow(const cv::Mat& image, const cv::Mat& matte, int below, const Eigen::Matrix3d& G,
                  const cv::Rect& roi, int x0, int py, int width, double* diff, int* compared);
   void Reproject();

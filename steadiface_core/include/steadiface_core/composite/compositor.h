@@ -112,6 +112,10 @@ class Compositor {
                    const cv::Mat& raw);
   // Fills the subject's uncovered pixels of `out` (over the background roi).
   void FillUncovered(const cv::Mat& subject, cv::Mat* out);
+  // FillUncovered's row y of the background roi (rows may run in
+  // parallel), adding to the uncovered and plate-filled weights.
+  void FillRow(const cv::Mat& subject, int y, double* uncovered, double* filled,
+               cv::Mat* out);
   // The subject over `out` (over the subject roi).
   void Blend(const cv::Mat& subject, cv::Mat* out);
 
