@@ -61,6 +61,40 @@ TEST(MsgConversionTest, AFollowedFaceIsPublishedAsFollowedNotValid) {
   EXPECT_FALSE(f.located());
 }
 
+TEST(MsgConversionTest, TheStateNamesTheRotationSourceAndPublishesNothingNonFinite) {
+  std_msgs::Header h;
+  h.frame_id = "camera";
+  steadiface::PipelineFrame pf;
+  pf.rotation_from_video = true;
+  pf.visual.valid = true;
+  pf.visual.tracked = 57;
+  pf.visual.inliers = 41;
+  pf.visual.residual_px = 0.31;
+  pf.visual.turn_error_px = std::numeric_limits<double>::quiet_NaN();
+  pf.composite.active = true;
+  pf.composite.report.matte_mean = std::numeric_limits<double>::infinity();
+  pf.composite.report.plate_share = 0.75;
+  pf.composite.report.plate_restarts = -3;
+  steadiface::StabilizerState m = ToMsg(pf, h, false);
+  EXPECT_EQ(m.rotation_source, "visual");
+  EXPECT_TRUE(m.visual_valid);
+  EXPECT_EQ(m.visual_tracked, 57u);
+  EXPECT_EQ(m.visual_inliers, 41u);
+  EXPECT_DOUBLE_EQ(m.visual_residual_px, 0.31);
+  EXPECT_EQ(m.visual_turn_error_px, 0.0);  // NaN is never published
+  EXPECT_EQ(m.warp_mode, "composite");
+  EXPECT_EQ(m.matte_mean, 0.0);  // nor infinity
+  EXPECT_DOUBLE_EQ(m.plate_share, 0.75);
+  EXPECT_EQ(m.plate_restarts, 0u);  // a negative count is clamped
+  // With the IMU, the visual fields stay empty whatever the estimator left.
+  pf.rotation_from_video = false;
+  m = ToMsg(pf, h, false);
+  EXPECT_EQ(m.rotation_source, "imu");
+  EXPECT_FALSE(m.visual_valid);
+  EXPECT_EQ(m.visual_tracked, 0u);
+  EXPECT_EQ(m.visual_residual_px, 0.0);
+}
+
 TEST(MsgConversionTest, DistortionModels) {
   steadiface::CameraIntrinsics k;
   sensor_msgs::CameraInfo info = MakeInfo();
