@@ -378,6 +378,9 @@ void StabilizerRos::DiagView(diagnostic_updater::DiagnosticStatusWrapper& s) {
                        : "gravity not known yet (readings far from 1 g are left out)");
     s.summary(diagnostic_msgs::DiagnosticStatus::WARN, what.str());
   }
+  if (!w.view_conflict.empty()) {
+    s.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, w.view_conflict);
+  }
 }
 
 void StabilizerRos::DiagExtrinsics(diagnostic_updater::DiagnosticStatusWrapper& s) {

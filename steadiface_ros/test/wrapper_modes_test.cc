@@ -107,6 +107,7 @@ TEST(WrapperTest, CompositeModeSwitchedOnAtRunTimePublishesItsState) {
     EXPECT_EQ(sink.images[i]->width, TestStream().images[0]->width);
   }
   EXPECT_TRUE(matted);  // the face was found and cut out
+  EXPECT_TRUE(w.CurrentStatus().view_conflict.empty());  // the fixed crop
   ASSERT_FALSE(sink.debug.empty());
   EXPECT_EQ(sink.errors.count("reconfigure"), 0u);
   ExpectAllFinite(sink);
@@ -139,6 +140,7 @@ TEST(WrapperTest, TheViewReachesTheStateAndCameraInfo) {
   }
   const WrapperStatus st = w.CurrentStatus();
   EXPECT_EQ(st.horizon_mode, "level");
+  EXPECT_TRUE(st.view_conflict.empty());  // global mode and the dynamic crop
   EXPECT_TRUE(st.horizon.active);
   // The walk's bob (2.6 m/s^2 at 1.8 Hz) puts many readings beyond 10 % of
   // 1 g: they are left out.
@@ -158,6 +160,21 @@ TEST(WrapperTest, TheViewReachesTheStateAndCameraInfo) {
   EXPECT_EQ(w2.CurrentStatus().horizon.inactive_reason, "no accelerometer");
   EXPECT_EQ(w2.CurrentStatus().counters.accel_in, 0u);
   EXPECT_EQ(bare.states.size(), TestStream().images.size());
+}
+
+// The composite with the dynamic crop runs, and the status says that they do
+// not go together (the "view" diagnostic WARNs with it).
+TEST(WrapperTest, TheCompositeWithTheDynamicCropIsNamedAConflict) {
+  steadiface::PipelineOptions o = Options();
+  o.warp.mode = steadiface::WarpMode::kComposite;
+  o.crop.mode = steadiface::CropMode::kDynamic;
+  Sink sink;
+  StabilizerWrapper w(o, WrapperOptions(), &sink);
+  Feed(&w, TestStream(), 0, 4);
+  EXPECT_EQ(sink.images.size(), 4u);
+  const std::string conflict = w.CurrentStatus().view_conflict;
+  EXPECT_NE(conflict.find("output/crop fixed"), std::string::npos) << conflict;
+  ExpectAllFinite(sink);
 }
 
 }  // namespace

@@ -135,6 +135,9 @@ struct WrapperStatus {
   uint64_t accel_accepted = 0, accel_rejected = 0;
   /// The last frame's crop (output/crop).
   steadiface::CropReport crop;
+  /// Why the configured view and warp mode do not go together (the
+  /// "view" diagnostic WARNs with it); empty when they do.
+  std::string view_conflict;
   /// The IMU extrinsics' source, and the frames of their TF lookup.
   ExtrinsicsState extrinsics = ExtrinsicsState::kConfigured;
   std::string extrinsics_from, extrinsics_to;
