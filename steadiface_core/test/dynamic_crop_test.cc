@@ -13,6 +13,7 @@
 #include "steadiface_core/view/dynamic_crop.h"
 #include "steadiface_core/view/shake_path.h"
 #include "steadiface_core/camera/output_geometry.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/warp/protrusion.h"
 
 namespace steadiface {
@@ -143,6 +144,26 @@ TEST(DynamicCropTest, OptionsAreChecked) {
   EXPECT_EQ(mode, CropMode::kDynamic);
   EXPECT_FALSE(ParseCropMode("zoom", &mode).ok());
   EXPECT_STREQ(CropModeName(CropMode::kFixed), "fixed");
+}
+
+// The composite's matte and plate do not follow the crop's zoom: valid
+// options, named a conflict (the node WARNs, steadiface_bag prints it);
+// every other pairing of warp mode and crop is none.
+TEST(DynamicCropTest, TheCompositeWithTheDynamicCropIsTheOneConflict) {
+  for (WarpMode w : {WarpMode::kGlobal, WarpMode::kLayered, WarpMode::kComposite}) {
+    for (CropMode c : {CropMode::kFixed, CropMode::kDynamic}) {
+      PipelineOptions o;
+      o.warp.mode = w;
+      o.crop.mode = c;
+      EXPECT_TRUE(ValidatePipelineOptions(o).ok());
+      const std::string conflict = OptionsConflict(o);
+      if (w == WarpMode::kComposite && c == CropMode::kDynamic) {
+        EXPECT_NE(conflict.find("output/crop fixed"), std::string::npos) << conflict;
+      } else {
+        EXPECT_EQ(conflict, "") << static_cast<int>(w) << " " << static_cast<int>(c);
+      }
+    }
+  }
 }
 
 TEST(DynamicCropTest, TheFixedCropNeverMoves) {

@@ -415,14 +415,7 @@ WrapperStatus StabilizerWrapper::CurrentStatus() const {
     s.accel_rejected = pipeline_->gravity().rejected();
   }
   s.horizon_mode = steadiface::HorizonModeName(options_.horizon.mode);
-  if (options_.warp.mode == steadiface::WarpMode::kComposite &&
-      options_.crop.mode == steadiface::CropMode::kDynamic) {
-    // docs/evaluation.md, "The dynamic crop": the matte lost most of the
-    // subject on some sequences.
-    s.view_conflict =
-        "the composite's matte and plate do not follow the dynamic crop's zoom: "
-        "use output/crop fixed with warp/mode composite";
-  }
+  s.view_conflict = steadiface::OptionsConflict(options_);
   return s;
 }
 

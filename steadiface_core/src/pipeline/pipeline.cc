@@ -58,6 +58,15 @@ Status ValidatePipelineOptions(const PipelineOptions& o) {
   return ValidateDynamicCropOptions(o.crop);
 }
 
+std::string OptionsConflict(const PipelineOptions& o) {
+  if (o.warp.mode == WarpMode::kComposite && o.crop.mode == CropMode::kDynamic) {
+    // On seed 2 of vlog, hair and walk the matte lost most of the subject.
+    return "the composite's matte and plate do not follow the dynamic crop's zoom: "
+           "use output/crop fixed with warp/mode composite";
+  }
+  return "";
+}
+
 Pipeline::Pipeline(const CameraModel& model, const PipelineOptions& options)
     : model_(model),
       options_(options),

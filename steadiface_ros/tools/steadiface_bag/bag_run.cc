@@ -17,6 +17,7 @@
 #include "steadiface_bag/bag_stabilizer.h"
 #include "steadiface_bag/bag_writer.h"
 #include "steadiface_core/face/landmark_predictor.h"
+#include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_ros/camera_info_source.h"
 #include "steadiface_ros/params.h"
 #include "steadiface_ros/stabilizer_wrapper.h"
@@ -172,6 +173,9 @@ class BagRun {
 Status BagRun::Prepare() {
   Status st = LoadBagOptions(a_, &po_, &wo_);
   if (!st.ok()) return st;
+  // Runs, as the node does (which WARNs on /diagnostics), but is said.
+  const std::string conflict = steadiface::OptionsConflict(po_);
+  if (!conflict.empty()) std::cerr << "steadiface_bag: warning: " << conflict << "\n";
   preload_ = PreloadLandmarks(po_);
   const bool quiet = a_.quiet;
   info_source_.reset(new steadiface_ros::CameraInfoSource(

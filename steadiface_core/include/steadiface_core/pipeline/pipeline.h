@@ -77,6 +77,14 @@ struct PipelineOptions {
 
 Status ValidatePipelineOptions(const PipelineOptions& options);
 
+/// Options that are valid and run, but are known to work poorly together:
+/// a sentence that names the conflict and what to set instead, or empty.
+/// Not an error: the node WARNs with it on /diagnostics ("view") and the
+/// tools print it. Today one: the composite (warp.mode kComposite) with the
+/// dynamic crop, whose zoom its matte and plate do not follow
+/// (docs/evaluation.md, "The dynamic crop").
+std::string OptionsConflict(const PipelineOptions& options);
+
 /// The stabilizer options a warp needs: in layered mode the background
 /// layer is solved every frame, and H is held within subject_reach of where
 /// it shows the face; a subject_reach of 0 becomes what the band absorbs,
