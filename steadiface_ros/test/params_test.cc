@@ -289,15 +289,17 @@ TEST(ParamsTest, AChoiceOutsideTheTablesNamesTheChoices) {
 }
 
 // The core's validation accepts every value the table's ranges allow: each
-// number at its min and at its max (a pair's partner set to the same end,
-// so low < high still holds).
+// number at its min and at its max (a pair's partner, and its partner's,
+// set to the same end, so low < high still holds).
 TEST(ParamsTest, TheCoreAcceptsEveryValueInTheTablesRanges) {
   const std::map<std::string, std::string> low_to_high = {
       {"face/min_spread_ratio", "face/max_spread_ratio"},
       {"dynamic/gyro_still", "dynamic/gyro_active"},
       {"dynamic/pose_low", "dynamic/pose_high"},
       {"dynamic/centre_variation_low", "dynamic/centre_variation_high"},
-      {"dynamic/scale_variation_low", "dynamic/scale_variation_high"}};
+      {"dynamic/scale_variation_low", "dynamic/scale_variation_high"},
+      {"visual/min_inliers_precise", "visual/min_inliers"},
+      {"visual/min_inliers", "visual/max_features"}};
   std::map<std::string, const ParameterSpec*> spec;
   for (const ParameterSpec& p : ParameterTable()) spec[p.key] = &p;
   // A source holding only the values the test sets.
@@ -328,9 +330,16 @@ TEST(ParamsTest, TheCoreAcceptsEveryValueInTheTablesRanges) {
     for (const bool at_max : {false, true}) {
       Values values;
       values.v[p.key] = at_max ? p.max : p.min;
-      for (const auto& pair : low_to_high) {
-        if (at_max && pair.first == p.key) values.v[pair.second] = spec[pair.second]->max;
-        if (!at_max && pair.second == p.key) values.v[pair.first] = spec[pair.first]->min;
+      // Partners follow along chains (a <= b <= c): repeat until none moves.
+      for (size_t round = 0; round < low_to_high.size(); ++round) {
+        for (const auto& pair : low_to_high) {
+          if (at_max && values.v.count(pair.first) != 0) {
+            values.v[pair.second] = spec[pair.second]->max;
+          }
+          if (!at_max && values.v.count(pair.second) != 0) {
+            values.v[pair.first] = spec[pair.first]->min;
+          }
+        }
       }
       steadiface::PipelineOptions po;
       WrapperOptions wo;
@@ -348,6 +357,27 @@ TEST(ParamsTest, AnOutOfRangeValueNamesItsKey) {
   const steadiface::Status s = LoadWithOverlay("output:\n  crop_ratio: 0.7\n", &po, &wo);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("output/crop_ratio"), std::string::npos) << s.message();
+}
+
+// The rotation from the video's options come from visual/*; a combination
+// the core refuses (more inliers required than features tracked) names it.
+TEST(ParamsTest, TheRotationFromTheVideoTakesItsKeys) {
+  steadiface::PipelineOptions po;
+  WrapperOptions wo;
+  ASSERT_TRUE(LoadWithOverlay("rotation_source: visual\nvisual:\n  max_features: 300\n"
+                              "  klt_window: 15\n  inlier_threshold: 1.5\n  body_width: 2.0\n",
+                              &po, &wo)
+                  .ok());
+  EXPECT_EQ(po.rotation_source, steadiface::RotationSource::kVisual);
+  EXPECT_EQ(po.visual.max_features, 300);
+  EXPECT_EQ(po.visual.klt_window_px, 15);
+  EXPECT_EQ(po.visual.inlier_threshold_px, 1.5);
+  EXPECT_EQ(po.visual.body_width, 2.0);
+  EXPECT_EQ(po.visual.min_inliers, steadiface::VisualRotationOptions().min_inliers);
+  const steadiface::Status s = LoadWithOverlay(
+      "rotation_source: visual\nvisual:\n  max_features: 10\n  min_inliers: 12\n", &po, &wo);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("max_features"), std::string::npos) << s.message();
 }
 
 }  // namespace
