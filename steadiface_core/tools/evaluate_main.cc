@@ -52,6 +52,9 @@ const char kUsage[] =
     "         centre, D face scales behind the landmarks; 0 = the paper's centre)\n"
     "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
     "         shows a 30 px face)\n"
+    "       [--head-motion K] (the head's own motion against the scene, K times\n"
+    "         the preset's: bob, sway, yaw, pitch, lean, drift)\n"
+    "       [--head-jitter K] (the head's 2-8 Hz jitter, K times the preset's)\n"
     "       [--crop-mode fixed|dynamic] (output.crop: the fixed crop ratio, or the\n"
     "         dynamic crop between --widest R and it; default: the package's)\n"
     "       [--horizon off|level|lock] (output.horizon: the roll against the\n"
@@ -95,6 +98,7 @@ void AddRunFlags(CommandLine* cl, EvaluationOptions* o) {
   });
   cl->Double("--gyro-scale", &o->gyro_scale).Double("--gyro-speed", &o->gyro_speed);
   cl->Double("--head-distance", &o->head_distance_m);
+  cl->Double("--head-motion", &o->head_motion_scale).Double("--head-jitter", &o->head_jitter_scale);
   cl->Value("--head-model", "relief or flat", [o](const std::string& v) {
     o->head_model = v;
     return v == "relief" || v == "flat";

@@ -64,6 +64,20 @@ int ResolveMethods(std::vector<std::string> asked, bool have_ffmpeg, std::ostrea
   return 0;
 }
 
+// The head's own motion against the scene, k times the preset's, and its
+// jitter j times (NaN: as the preset has them).
+Status ScaleHeadMotion(double k, double j, sim::HeadMotionOptions* h) {
+  if (k < 0.0 || j < 0.0) return Status::Error("--head-motion and --head-jitter must be >= 0");
+  if (std::isfinite(k)) {
+    for (double* a : {&h->bob_amplitude_m, &h->sway_amplitude_m, &h->yaw_amplitude_rad,
+                      &h->pitch_amplitude_rad, &h->lean_amplitude_m, &h->drift_amplitude_m}) {
+      *a *= k;
+    }
+  }
+  if (std::isfinite(j)) h->jitter_rms_m *= j;
+  return Status::Ok();
+}
+
 // The preset's simulator: 3 s (or the recorded trace's whole length) unless
 // a duration is given.
 Status MakeSimulator(const EvaluationOptions& o, const std::string& preset,
@@ -77,6 +91,7 @@ Status MakeSimulator(const EvaluationOptions& o, const std::string& preset,
   if (std::isfinite(o.gyro_scale)) so->real_gyro_scale = o.gyro_scale;
   if (std::isfinite(o.gyro_speed)) so->real_gyro_speed = o.gyro_speed;
   if (std::isfinite(o.head_distance_m)) so->head.distance_m = o.head_distance_m;
+  if (s.ok()) s = ScaleHeadMotion(o.head_motion_scale, o.head_jitter_scale, &so->head);
   if (!o.head_model.empty()) so->head_model = o.head_model;
   if (s.ok()) s = sim::Simulator::Create(*so, sim);
   if (s.ok() && !std::isfinite(o.duration_s) && (*sim)->real_gyro_span_s() > so->duration_s) {

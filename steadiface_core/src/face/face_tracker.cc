@@ -69,6 +69,8 @@ void FaceTracker::Reset() {
   region_motion_.Clear();
   following_ = false;
   have_own_shift_ = false;
+  have_own_change_ = false;
+  own_change_ms_ = 0.0;
   have_last_frame_ = false;
   fitted_last_frame_ = false;
   have_fitted_pose_ = false;
@@ -319,8 +321,19 @@ void FaceTracker::TakeFit(const cv::Mat& gray, const Candidate& c, bool acquirin
   // The head's own motion, for the follow's gate: the centre against where
   // the camera's rotation alone would have put it, when the face was
   // located in the frame before too.
+  const bool had_own_shift = have_own_shift_ && !following_;
+  const Eigen::Vector2d previous = own_shift_;
   have_own_shift_ = predicted_centre != nullptr && (fitted_last_frame_ || following_);
   if (have_own_shift_) own_shift_ = Mean(c.landmarks) - *predicted_centre;
+  // How much that motion changes between fitted frames: the follow's gate
+  // widens for a head that jitters (never from followed frames, where a
+  // cover's motion could widen it).
+  if (had_own_shift && have_own_shift_) {
+    constexpr double kRate = 0.1;  // about the last 10 fitted frames
+    const double d2 = (own_shift_ - previous).squaredNorm();
+    own_change_ms_ = have_own_change_ ? (1.0 - kRate) * own_change_ms_ + kRate * d2 : d2;
+    have_own_change_ = true;
+  }
   Accept(c, acquiring, patch, stamp, info);
   region_motion_.Remember(gray, BoxFromLandmarks(c.landmarks));
 }
@@ -465,7 +478,9 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
                                      : (next.axis_px += flow.mean_shift, true));
   // The region must move on as the head did: a median that does not is a
   // cover's motion (a hand that dragged the last landmarks into a turn, too).
-  const double gate = std::max(2.0, options_.follow_max_speed_change * scale);
+  const double noise =
+      have_own_change_ ? options_.follow_speed_change_noise * std::sqrt(own_change_ms_) : 0.0;
+  const double gate = std::max({2.0, options_.follow_max_speed_change * scale, noise});
   if (have_own_shift_ && (flow.mean_shift - own_shift_).norm() > gate) moved = false;
   next.axis_px += camera_at_axis;
   const Eigen::Vector2d centre = next.FaceCentre();

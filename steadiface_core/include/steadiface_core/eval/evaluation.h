@@ -61,6 +61,12 @@ struct EvaluationOptions {
   double gyro_scale = NAN, gyro_speed = NAN;
   /// The subject's distance [m].
   double head_distance_m = NAN;
+  /// The head's own motion against the scene scaled by this (bob, sway,
+  /// yaw, pitch, lean and drift amplitudes; the preset's frequencies) [-],
+  /// and its 2-8 Hz jitter by head_jitter_scale [-]: stress tests beyond
+  /// the presets.
+  double head_motion_scale = NAN;
+  double head_jitter_scale = NAN;
   /// The simulated head: relief or flat (empty: the simulator's default).
   std::string head_model;
 

@@ -102,6 +102,11 @@ struct FaceTrackerOptions {
   /// scales (RMS landmark radius) per frame, and at least 2 px; else the
   /// face is held [-].
   double follow_max_speed_change = 0.15;
+  /// ... or within this many times the RMS change of the head's own motion
+  /// from one fitted frame to the next, over the last fitted frames (about
+  /// 10, exponentially weighted), when that is larger: a head that jitters
+  /// more than the face scale's share is followed as it moves [-].
+  double follow_speed_change_noise = 3.0;
   /// How the head region's motion is measured.
   HeadRegionMotionOptions region_motion;
   /// The followed head turns about an axis this far behind its landmarks,
@@ -247,6 +252,10 @@ class FaceTracker {
   // rotation, when it was located in both frames [px/frame].
   Eigen::Vector2d own_shift_ = Eigen::Vector2d::Zero();
   bool have_own_shift_ = false;
+  // The mean square of that motion's change between fitted frames
+  // [px^2/frame^2], and whether it has a value.
+  double own_change_ms_ = 0.0;
+  bool have_own_change_ = false;
   std::vector<Eigen::Vector2d> fitted_landmarks_;  // the last fit's
   bool have_fitted_pose_ = false;                // the last fit's pose:
   double fitted_yaw_ = 0.0, fitted_pitch_ = 0.0, fitted_roll_ = 0.0;  // [rad]
