@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <set>
@@ -98,6 +99,32 @@ TEST(EvaluationTest, UnknownMethodsAndPresetsAreRefused) {
       << err2.str();
   std::remove((dir + "/report.json").c_str());
   rmdir(dir.c_str());
+}
+
+// A method run with options that conflict (the composite with the dynamic
+// crop) runs, and is said once on err; a negative stress is refused.
+TEST(EvaluationTest, ConflictingOptionsAreSaidAndNegativeStressesRefused) {
+  const std::string dir = TempDir();
+  eval::EvaluationOptions o = ShortStill(dir);
+  o.presets = {"still", "vlog"};
+  o.methods = {"gyro-only", "steadiface-composite"};
+  o.view.crop_mode = 1;  // dynamic
+  std::ostringstream out, err;
+  EXPECT_EQ(eval::RunEvaluation(o, out, err), 0) << err.str();
+  const std::string said = "steadiface-composite: warning: the composite's matte";
+  const size_t at = err.str().find(said);
+  EXPECT_NE(at, std::string::npos) << err.str();
+  EXPECT_EQ(err.str().find(said, at + 1), std::string::npos) << err.str();  // once
+  EXPECT_EQ(err.str().find("gyro-only: warning"), std::string::npos) << err.str();
+  o.view.crop_mode = 0;  // fixed: no conflict
+  std::ostringstream out2, err2;
+  EXPECT_EQ(eval::RunEvaluation(o, out2, err2), 0) << err2.str();
+  EXPECT_EQ(err2.str().find("warning"), std::string::npos) << err2.str();
+  o.head_jitter_scale = -1.0;
+  std::ostringstream out3, err3;
+  EXPECT_EQ(eval::RunEvaluation(o, out3, err3), 1);
+  EXPECT_NE(err3.str().find("--head-jitter must be >= 0"), std::string::npos) << err3.str();
+  std::filesystem::remove_all(dir);
 }
 
 TEST(EvaluationTest, ViewOverridesChangeOnlyWhatTheyName) {

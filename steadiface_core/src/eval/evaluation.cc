@@ -8,11 +8,13 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <set>
 
 #include "eval/evaluation_files.h"
 #include "steadiface_core/eval/ffmpeg_baseline.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/video_scorer.h"
+#include "steadiface_core/pipeline/pipeline.h"
 
 namespace steadiface {
 namespace eval {
@@ -247,6 +249,7 @@ Status PresetRun::RunPipeline(const std::string& name, Method m, bool video, Vid
                               std::vector<std::pair<std::string, std::string>>* composite_rows) {
   PipelineOptions po;
   Status s = PipelineOptionsFor(o_, *sim_, m, &po);
+  run->options_conflict = OptionsConflict(po);
   std::unique_ptr<Scorecard> card;
   if (s.ok()) s = MakeScorecard(*sim_, po, &card, o_.window_s);
   if (!s.ok()) return s;
@@ -346,6 +349,7 @@ int RunEvaluation(const EvaluationOptions& o, std::ostream& out, std::ostream& e
   bool first = true;
   int failures = 0;
   std::vector<std::pair<std::string, std::string>> composite_rows;  // table, csv
+  std::set<std::string> warned;  // methods whose options conflict, said once
   for (const std::string& preset : o.presets.empty() ? sim::PresetNames() : o.presets) {
     PresetRun pr(o, preset);
     const Status started = pr.Start();
@@ -367,6 +371,9 @@ int RunEvaluation(const EvaluationOptions& o, std::ostream& out, std::ostream& e
         err << preset << "/" << name << ": " << s.message() << "\n";
         ++failures;
         continue;
+      }
+      if (!run.options_conflict.empty() && warned.insert(name).second) {
+        err << name << ": warning: " << run.options_conflict << "\n";
       }
       out << TableRow(preset, name, sc, run) << std::endl;
       json << (first ? "" : ",\n") << JsonResult(preset, name, sc, run);

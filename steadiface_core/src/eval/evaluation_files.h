@@ -60,6 +60,7 @@ struct RunFigures {
   double face_fraction = NAN;  ///< frames whose face entered E_f
   bool approximate = false;    ///< scored from the output video
   double duration_s = 0.0;
+  std::string options_conflict;  ///< OptionsConflict of the run's options
 };
 
 /// The markdown table's header, and one run's row.
