@@ -40,9 +40,8 @@ const cv::Mat& HeadRegionMotion::Crop() const {
   // (the landmarks fit the next frame), and scaling a large head's crop
   // costs more than copying it.
   if (crop_.empty() && !cut_pixels_.empty()) {
-    const cv::Size size(cvRound(cut_.width * scale_), cvRound(cut_.height * scale_));
     if (scale_ < 1.0) {
-      cv::resize(cut_pixels_, crop_, size, 0, 0, cv::INTER_AREA);
+      cv::resize(cut_pixels_, crop_, crop_size_, 0, 0, cv::INTER_AREA);
     } else {
       crop_ = cut_pixels_;
     }
@@ -66,6 +65,7 @@ void HeadRegionMotion::Remember(const cv::Mat& grey, const cv::Rect2d& region) {
   if (size.width < 16 || size.height < 16) return;
   grey(c).copyTo(cut_pixels_);
   cut_ = c;
+  crop_size_ = size;
   region_ = region;
 }
 

@@ -76,6 +76,7 @@ class HeadRegionMotion {
   cv::Mat cut_pixels_;            // grey around region_, as cut from the frame
   mutable cv::Mat crop_;          // ... scaled by scale_ (Crop)
   cv::Rect cut_;                  // where crop_ was cut from the frame [px]
+  cv::Size crop_size_;            // crop_'s size: cut_ scaled by scale_ [px]
   double scale_ = 1.0;            // crop_ px per frame px
   cv::Rect2d region_;             // the region in the frame [px]
 };
