@@ -6,6 +6,7 @@
 // head", has the tables over seeds.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <vector>
@@ -35,6 +36,25 @@ eval::Score RunWith(const sim::Simulator& s, eval::Method m, double pivot_depth,
       frames);
 }
 
+// Runs the pipeline with `po` over every frame of `s`, handing each frame's
+// output and truth to `each`.
+void ForEachFrame(
+    const sim::Simulator& s, const PipelineOptions& po,
+    const std::function<void(int, const PipelineFrame&, const sim::SimTruth&)>& each) {
+  std::unique_ptr<Pipeline> p;
+  ASSERT_TRUE(Pipeline::Create(s.intrinsics(), po, &p).ok());
+  size_t g = 0;
+  cv::Mat frame;
+  sim::SimTruth truth;
+  for (int i = 0; i < s.num_frames(); ++i) {
+    eval::FeedGyroForFrame(s, s.Truth(i).stamp, po.imu.imu_time_offset_s, p.get(), &g);
+    ASSERT_TRUE(s.Render(i, &frame, &truth).ok());
+    PipelineFrame out;
+    ASSERT_TRUE(p->ProcessFrame(frame, truth.stamp, nullptr, 0.0, &out).ok());
+    each(i, out, truth);
+  }
+}
+
 // drift: a standing person whose head drifts and turns (yaw 12 deg RMS).
 // Following the landmarks' centre follows the turn (the paper's centre,
 // pivot depth 0); the pose-invariant centre holds the head.
@@ -61,21 +81,12 @@ TEST(TurningHeadTest, ThePoseInvariantCentreHoldsATurningHead) {
 // than gyro-only's.
 TEST(TurningHeadTest, AHeadTurnedPastTheLandmarksIsFollowed) {
   const auto s = MakeSimulator("turn_away");
-  std::unique_ptr<Pipeline> p;
   const PipelineOptions po = eval::OptionsFor(*s, eval::Method::kSteadiface);
-  ASSERT_TRUE(Pipeline::Create(s->intrinsics(), po, &p).ok());
-  size_t g = 0;
   int located = 0, followed = 0, followed_frontal = 0;
   double worst_axis = 0.0;
-  cv::Mat frame;
-  sim::SimTruth truth;
-  for (int i = 0; i < s->num_frames(); ++i) {
-    eval::FeedGyroForFrame(*s, s->Truth(i).stamp, po.imu.imu_time_offset_s, p.get(), &g);
-    ASSERT_TRUE(s->Render(i, &frame, &truth).ok());
-    PipelineFrame out;
-    ASSERT_TRUE(p->ProcessFrame(frame, truth.stamp, nullptr, 0.0, &out).ok());
+  ForEachFrame(*s, po, [&](int i, const PipelineFrame& out, const sim::SimTruth& truth) {
     located += out.face.located() ? 1 : 0;
-    if (!out.face.followed) continue;
+    if (!out.face.followed) return;
     ++followed;
     if (std::abs(truth.yaw) < 0.4) ++followed_frontal;
     // The followed head's axis (the pose-invariant centre) against the
@@ -86,7 +97,7 @@ TEST(TurningHeadTest, AHeadTurnedPastTheLandmarksIsFollowed) {
     if (i < s->num_frames() / 2) {
       worst_axis = std::max(worst_axis, std::abs(axis - truth.head_px.x()));
     }
-  }
+  });
   const eval::Score gyro = RunWith(*s, eval::Method::kGyroOnly, -1.0);
   const eval::Score held = RunWith(*s, eval::Method::kSteadiface, -1.0, nullptr, 0.0);
   const eval::Score ours = RunWith(*s, eval::Method::kSteadiface, -1.0);
@@ -123,22 +134,10 @@ TEST(TurningHeadTest, AJitteringHeadIsFollowedThroughItsTurn) {
     const auto tweak = [=](PipelineOptions* o) { o->face.follow_speed_change_noise = noise; };
     PipelineOptions po = eval::OptionsFor(*s, eval::Method::kSteadiface);
     tweak(&po);
-    std::unique_ptr<Pipeline> p;
-    EXPECT_TRUE(Pipeline::Create(s->intrinsics(), po, &p).ok());
     *followed = 0;
-    size_t g = 0;
-    cv::Mat frame;
-    sim::SimTruth truth;
-    for (int i = 0; p != nullptr && i < s->num_frames(); ++i) {
-      eval::FeedGyroForFrame(*s, s->Truth(i).stamp, po.imu.imu_time_offset_s, p.get(), &g);
-      PipelineFrame out;
-      if (!s->Render(i, &frame, &truth).ok() ||
-          !p->ProcessFrame(frame, truth.stamp, nullptr, 0.0, &out).ok()) {
-        ADD_FAILURE() << "frame " << i;
-        break;
-      }
+    ForEachFrame(*s, po, [followed](int, const PipelineFrame& out, const sim::SimTruth&) {
       *followed += out.face.followed ? 1 : 0;
-    }
+    });
     return testing_util::ScoreRun(*s, eval::Method::kSteadiface, tweak);
   };
   int followed_scale_only = 0, followed = 0;
