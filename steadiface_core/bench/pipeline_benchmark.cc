@@ -136,8 +136,12 @@ void BM_PipelineFrame(benchmark::State& state) {
     return p->ProcessFrame(seq.frames[k], stamp, nullptr, 0.0, out);
   };
   PipelineFrame out;
-  if (!restart() || !feed(i++, &out).ok()) {
-    state.SkipWithError("pipeline refused the first frame");
+  if (!restart()) {
+    state.SkipWithError("pipeline refused its options");
+    return;
+  }
+  if (const Status first = feed(i++, &out); !first.ok()) {
+    state.SkipWithError(("pipeline refused the first frame: " + first.message()).c_str());
     return;
   }
   for (auto _ : state) {
