@@ -66,20 +66,6 @@ int ResolveMethods(std::vector<std::string> asked, bool have_ffmpeg, std::ostrea
   return 0;
 }
 
-// The head's own motion against the scene, k times the preset's, and its
-// jitter j times (NaN: as the preset has them).
-Status ScaleHeadMotion(double k, double j, sim::HeadMotionOptions* h) {
-  if (k < 0.0 || j < 0.0) return Status::Error("--head-motion and --head-jitter must be >= 0");
-  if (std::isfinite(k)) {
-    for (double* a : {&h->bob_amplitude_m, &h->sway_amplitude_m, &h->yaw_amplitude_rad,
-                      &h->pitch_amplitude_rad, &h->lean_amplitude_m, &h->drift_amplitude_m}) {
-      *a *= k;
-    }
-  }
-  if (std::isfinite(j)) h->jitter_rms_m *= j;
-  return Status::Ok();
-}
-
 // The preset's simulator: 3 s (or the recorded trace's whole length) unless
 // a duration is given.
 Status MakeSimulator(const EvaluationOptions& o, const std::string& preset,
@@ -308,6 +294,18 @@ Status PresetRun::Run(const std::string& name, Score* sc, RunFigures* run, bool*
 }
 
 }  // namespace
+
+Status ScaleHeadMotion(double k, double j, sim::HeadMotionOptions* h) {
+  if (k < 0.0 || j < 0.0) return Status::Error("--head-motion and --head-jitter must be >= 0");
+  if (std::isfinite(k)) {
+    for (double* a : {&h->bob_amplitude_m, &h->sway_amplitude_m, &h->yaw_amplitude_rad,
+                      &h->pitch_amplitude_rad, &h->lean_amplitude_m, &h->drift_amplitude_m}) {
+      *a *= k;
+    }
+  }
+  if (std::isfinite(j)) h->jitter_rms_m *= j;
+  return Status::Ok();
+}
 
 Status ApplyViewOverrides(const ViewOverrides& v, PipelineOptions* po) {
   auto set = [](double flag, double* field) {

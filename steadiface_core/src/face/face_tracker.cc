@@ -68,6 +68,7 @@ void FaceTracker::Reset() {
   reference_yaw_ = 0.0;
   region_motion_.Clear();
   following_ = false;
+  past_profile_ = false;
   have_own_shift_ = false;
   have_own_change_ = false;
   own_change_ms_ = 0.0;
@@ -107,6 +108,7 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
   last_landmarks_ = c.landmarks;
   fitted_landmarks_ = c.landmarks;
   following_ = false;
+  past_profile_ = false;
   last_seen_ = stamp;
   last_located_ = stamp;
   state_ = TrackingState::kTracking;
@@ -424,7 +426,7 @@ bool FaceTracker::StartFollow(Time stamp, double scale) {
   // followed by their translation, briefly, while they continue the head's
   // own motion (Follow's gate), so the tracker never follows the cover.
   const double since_fit = ToSeconds(stamp - last_seen_);
-  const bool turned = options_.follow_turned_s > 0.0 && have_fitted_pose_ &&
+  const bool turned = options_.follow_turned_s > 0.0 && have_fitted_pose_ && !past_profile_ &&
                       recent_abs_yaw_ >= options_.follow_min_yaw_rad &&
                       since_fit <= options_.follow_turned_s;
   const bool covered = options_.follow_covered_s > 0.0 && have_own_shift_ &&
@@ -484,7 +486,10 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
   if (have_own_shift_ && (flow.mean_shift - own_shift_).norm() > gate) moved = false;
   next.axis_px += camera_at_axis;
   const Eigen::Vector2d centre = next.FaceCentre();
-  if (!moved || (centre - pc).norm() > options_.max_jump * scale) {
+  // A head turned past its profile is not followed further (the follow's
+  // turn back from it drifts): it is held until the landmarks fit again.
+  if (next.past_profile) past_profile_ = true;
+  if (!moved || past_profile_ || (centre - pc).norm() > options_.max_jump * scale) {
     return StopFollowing();
   }
   std::vector<Eigen::Vector2d> lm = fitted_landmarks_;

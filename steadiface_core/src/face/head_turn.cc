@@ -57,7 +57,9 @@ bool UpdateHeadTurn(const RegionFlow& flow, HeadTurn* head) {
   const double d_axis = dx_mean + d_yaw * z_mean;
   if (!std::isfinite(d_axis) || !std::isfinite(dy_mean)) return false;
   head->axis_px += Eigen::Vector2d(d_axis, dy_mean);
-  head->yaw = std::max(-1.5, std::min(1.5, head->yaw + d_yaw));
+  const double yaw = head->yaw + d_yaw;
+  head->past_profile = head->past_profile || std::abs(yaw) >= kHeadTurnMaxYaw;
+  head->yaw = std::max(-kHeadTurnMaxYaw, std::min(kHeadTurnMaxYaw, yaw));
   return true;
 }
 

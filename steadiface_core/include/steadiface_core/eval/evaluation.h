@@ -9,6 +9,7 @@
 #include "steadiface_core/composite/compositor.h"
 #include "steadiface_core/layered/layer_blend.h"
 #include "steadiface_core/pipeline/pipeline.h"
+#include "steadiface_core/sim/motion.h"
 
 namespace steadiface {
 namespace eval {
@@ -107,6 +108,12 @@ struct EvaluationOptions {
 /// Applies the overrides to one method's pipeline options; an unknown
 /// horizon mode is an error.
 Status ApplyViewOverrides(const ViewOverrides& view, PipelineOptions* options);
+
+/// The simulated head's own motion against the scene (bob, sway, yaw,
+/// pitch, lean, drift) k times the preset's, and its 2-8 Hz jitter j times
+/// (NaN: as the preset has them); negative factors are refused
+/// (`--head-motion`, `--head-jitter`).
+Status ScaleHeadMotion(double k, double j, sim::HeadMotionOptions* head);
 
 /// Runs every preset with every method and scores each against the
 /// simulator's truth. Prints one markdown row per (preset, method) to `out`

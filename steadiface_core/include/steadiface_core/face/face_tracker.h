@@ -247,6 +247,7 @@ class FaceTracker {
   HeadRegionMotion region_motion_;               // the head's crop, for Follow
   bool following_ = false;                       // Follow's state:
   bool following_covered_ = false;               // ... by translation only
+  bool past_profile_ = false;  // a follow ended past the profile: none until the next fit
   HeadTurn head_turn_;                           // the followed head
   // The head's own motion over the last frame, beyond the camera's
   // rotation, when it was located in both frames [px/frame].

@@ -16,6 +16,13 @@ namespace steadiface {
 /// 4.6-5.6 / 4.6-5.6 px [-].
 constexpr double kHeadTurnRateGain = 0.7;
 
+/// The largest |yaw| the cylinder follows [rad]. A head turned further
+/// shows the far side of its skull, and the flow no longer tells the turn
+/// from the axis' motion: the turn back from a profile was measured two
+/// to three times too fast (turn_away at 1.3x the head's motion), its axis
+/// 50 px off. A follow that reaches it ends (HeadTurn::past_profile).
+constexpr double kHeadTurnMaxYaw = 1.5;
+
 /// A head followed through a turn past what the landmark model fits, as a
 /// vertical cylinder about its turning axis: the cylinder head model
 /// (La Cascia, Sclaroff and Athitsos 2000; Xiao, Kanade and Cohn 2002)
@@ -35,6 +42,9 @@ struct HeadTurn {
   double yaw_rate = 0.0;
   /// The face's distance from the axis in the image [px].
   double radius_px = 0.0;
+  /// The yaw reached kHeadTurnMaxYaw: the head is past what the cylinder
+  /// follows.
+  bool past_profile = false;
 
   /// Where the landmark centre is while the head is turned so [px].
   Eigen::Vector2d FaceCentre() const;
@@ -44,7 +54,8 @@ struct HeadTurn {
 /// the yaw by its part proportional to depth (least squares over the
 /// tracks). When the tracks' depths do not spread (they all face the
 /// camera, or all sit at the silhouette) the turn is not observable and
-/// only the translation is taken. The yaw stays within +-1.5 rad and
+/// only the translation is taken. The yaw stays within +-kHeadTurnMaxYaw
+/// (past_profile once it reaches it) and
 /// changes at most 0.15 rad per frame; its rate is filtered (kHeadTurnRateGain). False (state kept) with fewer than 3
 /// tracks or a radius <= 0.
 bool UpdateHeadTurn(const RegionFlow& flow, HeadTurn* head);
