@@ -124,6 +124,11 @@ TEST(EvaluationTest, ConflictingOptionsAreSaidAndNegativeStressesRefused) {
   std::ostringstream out3, err3;
   EXPECT_EQ(eval::RunEvaluation(o, out3, err3), 1);
   EXPECT_NE(err3.str().find("--head-jitter must be >= 0"), std::string::npos) << err3.str();
+  o.head_jitter_scale = NAN;
+  o.head_turn_speed = 0.0;
+  std::ostringstream out4, err4;
+  EXPECT_EQ(eval::RunEvaluation(o, out4, err4), 1);
+  EXPECT_NE(err4.str().find("--head-turn-speed must be in"), std::string::npos) << err4.str();
   std::filesystem::remove_all(dir);
 }
 

@@ -116,7 +116,7 @@ TEST(StabilizerTest, SubjectReachHoldsTheTargetNearTheBackgroundLayersFace) {
     const RunResult gyro = RunSequence(m, seq, go);
     double worst = 0.0;  // max |H - C_bg| / jaw width
     // The face as the stabilizer reads it: at the pose-invariant centre.
-    PoseInvariantCentre invariant(so.dynamic.pose_pivot_depth, so.dynamic.pose_yaw_time_constant_s);
+    PoseInvariantCentre invariant(so.dynamic);
     for (size_t i = 0; i < r.frames_out.size(); ++i) {
       const StabilizerFrame& f = r.frames_out[i];
       EXPECT_EQ(f.background.R_v.coeffs(), gyro.frames_out[i].R_v.coeffs()) << i;

@@ -55,6 +55,9 @@ const char kUsage[] =
     "       [--head-motion K] (the head's own motion against the scene, K times\n"
     "         the preset's: bob, sway, yaw, pitch, lean, drift)\n"
     "       [--head-jitter K] (the head's 2-8 Hz jitter, K times the preset's)\n"
+    "       [--head-yaw RAD] [--head-turn-speed K] (the head's yaw amplitude\n"
+    "         instead of the preset's, and its turns K times as fast: turn_away\n"
+    "         with --head-yaw 0.8 --head-turn-speed 3 shakes the head \"no\")\n"
     "       [--crop-mode fixed|dynamic] (output.crop: the fixed crop ratio, or the\n"
     "         dynamic crop between --widest R and it; default: the package's)\n"
     "       [--horizon off|level|lock] (output.horizon: the roll against the\n"
@@ -99,6 +102,7 @@ void AddRunFlags(CommandLine* cl, EvaluationOptions* o) {
   cl->Double("--gyro-scale", &o->gyro_scale).Double("--gyro-speed", &o->gyro_speed);
   cl->Double("--head-distance", &o->head_distance_m);
   cl->Double("--head-motion", &o->head_motion_scale).Double("--head-jitter", &o->head_jitter_scale);
+  cl->Double("--head-yaw", &o->head_yaw_rad).Double("--head-turn-speed", &o->head_turn_speed);
   cl->Value("--head-model", "relief or flat", [o](const std::string& v) {
     o->head_model = v;
     return v == "relief" || v == "flat";

@@ -79,6 +79,7 @@ Status MakeSimulator(const EvaluationOptions& o, const std::string& preset,
   if (std::isfinite(o.gyro_scale)) so->real_gyro_scale = o.gyro_scale;
   if (std::isfinite(o.gyro_speed)) so->real_gyro_speed = o.gyro_speed;
   if (std::isfinite(o.head_distance_m)) so->head.distance_m = o.head_distance_m;
+  if (s.ok()) s = SetHeadTurn(o.head_yaw_rad, o.head_turn_speed, &so->head);
   if (s.ok()) s = ScaleHeadMotion(o.head_motion_scale, o.head_jitter_scale, &so->head);
   if (!o.head_model.empty()) so->head_model = o.head_model;
   if (s.ok()) s = sim::Simulator::Create(*so, sim);
@@ -294,6 +295,14 @@ Status PresetRun::Run(const std::string& name, Score* sc, RunFigures* run, bool*
 }
 
 }  // namespace
+
+Status SetHeadTurn(double yaw_rad, double speed, sim::HeadMotionOptions* h) {
+  if (yaw_rad < 0.0 || yaw_rad > 3.2) return Status::Error("--head-yaw must be in [0, 3.2] rad");
+  if (speed <= 0.0 || speed > 20.0) return Status::Error("--head-turn-speed must be in (0, 20]");
+  if (std::isfinite(yaw_rad)) h->yaw_amplitude_rad = yaw_rad;
+  if (std::isfinite(speed)) h->yaw_hz *= speed;
+  return Status::Ok();
+}
 
 Status ScaleHeadMotion(double k, double j, sim::HeadMotionOptions* h) {
   if (k < 0.0 || j < 0.0) return Status::Error("--head-motion and --head-jitter must be >= 0");

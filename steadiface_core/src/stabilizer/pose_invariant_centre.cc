@@ -1,26 +1,48 @@
 #include "steadiface_core/stabilizer/pose_invariant_centre.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace steadiface {
+namespace {
 
-FaceObservation PoseInvariantCentre::Apply(const FaceObservation& face,
-                                           double dt) {
+// The one-euro filter's cut-off of the speed estimate [Hz] (its authors'
+// default).
+constexpr double kSpeedCutoffHz = 1.0;
+
+// A first-order low-pass's gain for a step of `dt` at cut-off `hz`.
+double Gain(double dt, double hz) { return 1.0 - std::exp(-2.0 * M_PI * hz * dt); }
+
+}  // namespace
+
+void PoseInvariantCentre::FilterYaw(double yaw, double dt) {
+  const double tau = options_.pose_yaw_time_constant_s;
+  if (!has_yaw_ || !(dt > 0.0) || tau <= 0.0) {
+    yaw_ = yaw;
+    yaw_speed_ = 0.0;
+    return;
+  }
+  // One-euro filter (Casiez, Roussel and Vogel 2012): the speed, low-passed,
+  // opens the yaw's low-pass above a floor, so that a slow or still head's
+  // PnP noise is smoothed and a fast turn is not followed late.
+  const double h = std::min(dt, 1.0);
+  yaw_speed_ += Gain(h, kSpeedCutoffHz) * ((yaw - yaw_) / h - yaw_speed_);
+  const double excess = std::max(0.0, std::abs(yaw_speed_) - options_.pose_yaw_speed_floor_rad_s);
+  const double cutoff_hz = 1.0 / (2.0 * M_PI * tau) + options_.pose_yaw_speed_gain * excess;
+  yaw_ += Gain(h, cutoff_hz) * (yaw - yaw_);
+}
+
+FaceObservation PoseInvariantCentre::Apply(const FaceObservation& face, double dt) {
   last_shift_ = 0.0;
-  if (pivot_depth_ <= 0.0 || !face.valid || !face.has_pose ||
+  if (options_.pose_pivot_depth <= 0.0 || !face.valid || !face.has_pose ||
       !std::isfinite(face.yaw) || !(face.scale > 0.0)) {
     return face;
   }
-  if (!has_yaw_ || !(dt > 0.0) || time_constant_s_ <= 0.0) {
-    yaw_ = face.yaw;
-  } else {
-    const double a = std::exp(-std::min(dt, 1.0) / time_constant_s_);
-    yaw_ = a * yaw_ + (1.0 - a) * face.yaw;
-  }
+  FilterYaw(face.yaw, dt);
   has_yaw_ = true;
   // The landmarks' centre sits at -d sin(yaw) (x right) from where it would
   // be facing the camera: moved back by +d sin(yaw).
-  last_shift_ = pivot_depth_ * face.scale * std::sin(yaw_);
+  last_shift_ = options_.pose_pivot_depth * face.scale * std::sin(yaw_);
   FaceObservation out = face;
   for (Eigen::Vector2d& l : out.landmarks) l.x() += last_shift_;
   out.centre.x() += last_shift_;

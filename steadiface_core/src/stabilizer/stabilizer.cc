@@ -70,7 +70,7 @@ Stabilizer::Stabilizer(const CameraModel& model, const OutputGeometry& output,
       options_(options),
       smoother_(options.head),
       dynamic_(options.dynamic),
-      pose_centre_(options.dynamic.pose_pivot_depth, options.dynamic.pose_yaw_time_constant_s),
+      pose_centre_(options.dynamic),
       background_dynamic_(options.dynamic),
       reach_anchor_(ReachAnchorHz(options)) {}
 
@@ -90,8 +90,7 @@ Status Stabilizer::UpdateOptions(const StabilizerOptions& options) {
   smoother_ = HeadSmoother(options.head);
   dynamic_.set_options(options.dynamic);
   background_dynamic_.set_options(options.dynamic);
-  pose_centre_ = PoseInvariantCentre(options.dynamic.pose_pivot_depth,
-                                     options.dynamic.pose_yaw_time_constant_s);
+  pose_centre_ = PoseInvariantCentre(options.dynamic);
   if (!options.background_layer) background_ = LayerState();
   return Status::Ok();
 }

@@ -61,6 +61,8 @@ Status ValidateStabilizerOptions(const StabilizerOptions& o) {
       Range("dynamic.pose_smoothness_boost", d.pose_smoothness_boost, 0, 100),
       Range("dynamic.pose_pivot_depth", d.pose_pivot_depth, 0, 10),
       Range("dynamic.pose_yaw_time_constant", d.pose_yaw_time_constant_s, 0, 10),
+      Range("dynamic.pose_yaw_speed_gain", d.pose_yaw_speed_gain, 0, 100),
+      Range("dynamic.pose_yaw_speed_floor", d.pose_yaw_speed_floor_rad_s, 0, 20),
       Range("dynamic.variation_window", d.variation_window, 3, 1000),
       Range("dynamic.centre_variation_low", d.centre_variation_low, 0, 1),
       Range("dynamic.centre_variation_high", d.centre_variation_high,

@@ -68,6 +68,11 @@ struct EvaluationOptions {
   /// the presets.
   double head_motion_scale = NAN;
   double head_jitter_scale = NAN;
+  /// The head's yaw amplitude instead of the preset's [rad] (then scaled by
+  /// head_motion_scale), and its turns' frequency times this [-]: fast
+  /// turns, a head shaking "no".
+  double head_yaw_rad = NAN;
+  double head_turn_speed = NAN;
   /// The simulated head: relief or flat (empty: the simulator's default).
   std::string head_model;
 
@@ -114,6 +119,11 @@ Status ApplyViewOverrides(const ViewOverrides& view, PipelineOptions* options);
 /// (NaN: as the preset has them); negative factors are refused
 /// (`--head-motion`, `--head-jitter`).
 Status ScaleHeadMotion(double k, double j, sim::HeadMotionOptions* head);
+
+/// The simulated head's yaw amplitude set to `yaw_rad` and its turns'
+/// frequency scaled by `speed` (NaN: as the preset has them); out of range
+/// is refused (`--head-yaw`, `--head-turn-speed`).
+Status SetHeadTurn(double yaw_rad, double speed, sim::HeadMotionOptions* head);
 
 /// Runs every preset with every method and scores each against the
 /// simulator's truth. Prints one markdown row per (preset, method) to `out`

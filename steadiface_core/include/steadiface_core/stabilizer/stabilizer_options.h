@@ -87,8 +87,17 @@ struct DynamicWeightOptions {
   double pose_pivot_depth = 1.5;
   /// Time constant of the causal low-pass on the yaw that moves the
   /// landmarks: the pose from PnP is noisier from frame to frame than the
-  /// landmarks' centre [s].
+  /// landmarks' centre [s]. It holds while the head turns slowly; ...
   double pose_yaw_time_constant_s = 0.1;
+  /// ... faster, the low-pass opens (a one-euro filter, Casiez et al.
+  /// 2012): its cut-off rises by this many Hz per rad/s of the yaw's
+  /// filtered speed above pose_yaw_speed_floor_rad_s, so a fast turn is
+  /// not followed late (0.1 s behind a head shaken at 140 deg/s puts the
+  /// centre 20 px off) [Hz/(rad/s)]. 0 = a plain low-pass.
+  double pose_yaw_speed_gain = 5.0;
+  /// The yaw's speed below which the low-pass stays at its time constant
+  /// (PnP's frame-to-frame noise reads as about this much speed) [rad/s].
+  double pose_yaw_speed_floor_rad_s = 0.8;
   /// Frames in the landmark-variation window [count].
   int variation_window = 10;
   /// RMS second difference of the gyro-compensated landmark centre at which
