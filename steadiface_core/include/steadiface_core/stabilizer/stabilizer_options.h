@@ -92,11 +92,13 @@ struct DynamicWeightOptions {
   /// ... faster, the low-pass opens (a one-euro filter, Casiez et al.
   /// 2012): its cut-off rises by this many Hz per rad/s of the yaw's
   /// filtered speed above pose_yaw_speed_floor_rad_s, so a fast turn is
-  /// not followed late (0.1 s behind a head shaken at 140 deg/s puts the
-  /// centre 20 px off) [Hz/(rad/s)]. 0 = a plain low-pass.
+  /// not followed late (the 0.1 s low-pass lags a head shaken at 140 deg/s
+  /// by 0.2 rad, its centre 0.3 face scales off) [Hz/(rad/s)]. 0 = a plain
+  /// low-pass.
   double pose_yaw_speed_gain = 5.0;
-  /// The yaw's speed below which the low-pass stays at its time constant
-  /// (PnP's frame-to-frame noise reads as about this much speed) [rad/s].
+  /// The yaw's speed below which the low-pass stays at its time constant,
+  /// keeping PnP's frame-to-frame noise out (0.5 cost up to 10 % of head
+  /// jitter on slow presets, docs/evaluation.md) [rad/s].
   double pose_yaw_speed_floor_rad_s = 0.8;
   /// Frames in the landmark-variation window [count].
   int variation_window = 10;
