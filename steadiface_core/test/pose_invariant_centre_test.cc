@@ -67,9 +67,10 @@ double FilteredYaw(double gain, int n, const std::function<double(int)>& yaw) {
 // A head shaken at 2.5 rad/s (140 deg/s): the plain low-pass lags by
 // (1 - g) / g frames of the turn, g = 1 - exp(-1/3) its gain per frame
 // (0.21 rad: 1.5 face scales of pivot put the centre 0.3 face scales off);
-// the one-euro filter opens and lags by a fraction of that. A still head's PnP noise (+-0.03 rad from frame to
-// frame, about 1 rad/s of apparent speed, halved by the speed's own
-// low-pass) is smoothed as much as by the plain low-pass.
+// the one-euro filter opens and lags by a fraction of that. A still head's
+// PnP noise (+-0.03 rad from frame to frame, 1.8 rad/s of change, which
+// the speed's own 1 Hz low-pass averages to about 0.2 rad/s, below the
+// floor) is smoothed exactly as by the plain low-pass.
 TEST(PoseInvariantCentreTest, AFastTurnIsNotFollowedLateAndNoiseStaysSmoothed) {
   const auto ramp = [](int k) { return 2.5 * k / 30.0; };
   const double plain_lag = ramp(14) - FilteredYaw(0.0, 15, ramp);

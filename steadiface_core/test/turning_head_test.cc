@@ -17,8 +17,8 @@
 #include "sim_util.h"
 #include "steadiface_core/eval/evaluation.h"
 #include "steadiface_core/eval/run_methods.h"
-#include "steadiface_core/face/head_turn.h"
 #include "steadiface_core/eval/scorecard.h"
+#include "steadiface_core/face/head_turn.h"
 #include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
 
@@ -55,6 +55,13 @@ void ForEachFrame(
     ASSERT_TRUE(p->ProcessFrame(frame, truth.stamp, nullptr, 0.0, &out).ok());
     each(i, out, truth);
   }
+}
+
+// A followed head's axis, the pose-invariant centre, in the image [px]:
+// the located centre moved back by the pivot's swing.
+double FollowedAxisX(const PipelineOptions& po, const FaceInfo& face) {
+  return face.centre_px.x() +
+         po.stabilizer.dynamic.pose_pivot_depth * face.scale_px * std::sin(face.yaw);
 }
 
 // drift: a standing person whose head drifts and turns (yaw 12 deg RMS).
@@ -94,9 +101,7 @@ TEST(TurningHeadTest, AHeadTurnedPastTheLandmarksIsFollowed) {
     if (std::abs(truth.yaw) < 0.4) ++followed_frontal;
     // The followed head's axis (the pose-invariant centre) against the
     // truth's, while turning away (the yaw still growing).
-    const double axis = out.face.centre_px.x() +
-                        po.stabilizer.dynamic.pose_pivot_depth * out.face.scale_px *
-                            std::sin(out.face.yaw);
+    const double axis = FollowedAxisX(po, out.face);
     if (i < s->num_frames() / 2) {
       worst_axis = std::max(worst_axis, std::abs(axis - truth.head_px.x()));
     }
@@ -178,9 +183,7 @@ TEST(TurningHeadTest, AHeadTurnedToItsProfileIsHeldNotFollowedBack) {
     ++followed;
     followed_after_profile += profile ? 1 : 0;
     if (std::abs(out.face.yaw) >= kHeadTurnMaxYaw) profile = true;
-    const double axis = out.face.centre_px.x() +
-                        po.stabilizer.dynamic.pose_pivot_depth * out.face.scale_px *
-                            std::sin(out.face.yaw);
+    const double axis = FollowedAxisX(po, out.face);
     worst_axis = std::max(worst_axis, std::abs(axis - truth.head_px.x()));
   });
   const eval::Score gyro = RunWith(*s, eval::Method::kGyroOnly, -1.0);

@@ -487,9 +487,10 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
   next.axis_px += camera_at_axis;
   const Eigen::Vector2d centre = next.FaceCentre();
   // A head turned past its profile is not followed further (the follow's
-  // turn back from it drifts): it is held until the landmarks fit again.
+  // turn back from it drifts): it is held, and no follow starts again,
+  // until the landmarks fit (StartFollow).
   if (next.past_profile) past_profile_ = true;
-  if (!moved || past_profile_ || (centre - pc).norm() > options_.max_jump * scale) {
+  if (!moved || next.past_profile || (centre - pc).norm() > options_.max_jump * scale) {
     return StopFollowing();
   }
   std::vector<Eigen::Vector2d> lm = fitted_landmarks_;
