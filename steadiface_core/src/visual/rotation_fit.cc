@@ -35,12 +35,13 @@ std::vector<int> Inliers(const std::vector<BearingPair>& pairs,
 
 using Matrix9 = Eigen::Matrix<double, 9, 9>;
 
-// The Gauss-Newton normal equations of the pairs `in` at `m`, priors
-// included. The Jacobian takes the rotation as small (b2 + b2 x dphi for a
-// change dphi): one frame's turn is a few degrees, and the residuals
-// themselves are exact.
-void NormalEquations(const std::vector<BearingPair>& pairs,
-                     const std::vector<int>& in, const Motion& m,
+// The Gauss-Newton normal equations of the pairs `in` at `m`, each pair's
+// rows weighted by `weights` (empty: 1 each), priors included. The
+// Jacobian takes the rotation as small (b2 + b2 x dphi for a change dphi):
+// one frame's turn is a few degrees, and the residuals themselves are
+// exact.
+void NormalEquations(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
+                     const std::vector<double>& weights, const Motion& m,
                      const MotionPrior& prior, Matrix9* JtJ, Motion* Jtr) {
   JtJ->setZero();
   Jtr->setZero();
@@ -56,8 +57,9 @@ void NormalEquations(const std::vector<BearingPair>& pairs,
     const Eigen::Matrix<double, 2, 3> Jphi = Jp * skew;
     Eigen::Matrix<double, 2, 9> J;
     J << p.c * Jphi, p.d * Jphi, p.e * Jphi;
-    *JtJ += J.transpose() * J;
-    *Jtr += J.transpose() * r;
+    const double w = weights.empty() ? 1.0 : weights[i];
+    *JtJ += w * J.transpose() * J;
+    *Jtr += w * J.transpose() * r;
   }
   // The priors: alpha |alpha|^2 + beta |beta|^2.
   JtJ->diagonal().segment<3>(3).array() += prior.alpha;
@@ -66,14 +68,16 @@ void NormalEquations(const std::vector<BearingPair>& pairs,
   Jtr->tail<3>() += prior.beta * m.tail<3>();
 }
 
-// Gauss-Newton on the pairs `in` (9 unknowns), damped a little so that a
-// triple's nearly singular system stays bounded.
+// Gauss-Newton on the pairs `in` (9 unknowns), each weighted by `weights`
+// (empty: 1 each), damped a little so that a triple's nearly singular
+// system stays bounded.
 Motion Refine(const std::vector<BearingPair>& pairs, const std::vector<int>& in,
-              Motion m, int iterations, const MotionPrior& prior) {
+              const std::vector<double>& weights, Motion m, int iterations,
+              const MotionPrior& prior) {
   for (int iter = 0; iter < iterations; ++iter) {
     Matrix9 JtJ;
     Motion Jtr;
-    NormalEquations(pairs, in, m, prior, &JtJ, &Jtr);
+    NormalEquations(pairs, in, weights, m, prior, &JtJ, &Jtr);
     JtJ.diagonal() *= 1.0 + 1e-9;
     JtJ.diagonal().array() += 1e-12;
     const Motion delta = JtJ.ldlt().solve(-Jtr);
@@ -94,7 +98,7 @@ double TurnSigmaPx(const std::vector<BearingPair>& pairs,
   constexpr double kMinSigmaPx = 0.25;  // a residual this small is luck
   Matrix9 JtJ;
   Motion Jtr;
-  NormalEquations(pairs, in, m, prior, &JtJ, &Jtr);
+  NormalEquations(pairs, in, {}, m, prior, &JtJ, &Jtr);
   double c = 0.0, d = 0.0, e = 0.0;
   for (int i : in) {
     c += pairs[i].c / in.size();
@@ -146,7 +150,7 @@ Hypothesis Ransac(const std::vector<BearingPair>& pairs, const std::vector<doubl
     const int b = (a + 1 + pick(*rng) % (n - 1)) % n;
     int c = pick(*rng);
     if (c == a || c == b) continue;
-    const Motion m = Refine(pairs, {a, b, c}, Motion::Zero(), 3, prior);
+    const Motion m = Refine(pairs, {a, b, c}, {}, Motion::Zero(), 3, prior);
     if (!m.allFinite()) continue;
     std::vector<int> in = Inliers(pairs, m, focal_px, threshold_px);
     double w = 0.0;
@@ -184,7 +188,7 @@ bool FitMotion(const std::vector<BearingPair>& pairs, const std::vector<double>&
   Motion best_m = h.motion;
   if (best.size() < 3) return false;
   for (int round = 0; round < 2; ++round) {
-    best_m = Refine(pairs, best, best_m, 5, prior);
+    best_m = Refine(pairs, best, weights, best_m, 5, prior);
     best = Inliers(pairs, best_m, focal_px, threshold_px);
     if (best.size() < 3) return false;
   }

@@ -55,7 +55,11 @@ struct RotationFit {
 /// kept), then Gauss-Newton on the inliers, twice, with the `prior`.
 /// A hypothesis is scored by its inliers' summed `weights` (one per pair;
 /// empty: 1 each), so that features long known to move with the scene
-/// outvote fresh ones on a passer-by. `focal_px` turns normalized residuals
+/// outvote fresh ones on a passer-by, and the Gauss-Newton weighs each
+/// inlier's residual by its weight too, so that fresh features on a near
+/// object, which fit the rotation to within the threshold, pull the
+/// rotation less. The weights are not scaled: a set of long-known features
+/// leans on the prior less than a fresh set does. `focal_px` turns normalized residuals
 /// into pixels. Deterministic for a given `seed`. False with fewer than
 /// three pairs.
 bool FitMotion(const std::vector<BearingPair>& pairs, const std::vector<double>& weights,

@@ -56,6 +56,11 @@ Status ValidateVisualRotationOptions(const VisualRotationOptions& o) {
   } else if (!(o.face_margin >= 0.0 && o.face_margin <= 10.0) ||
              !(o.body_width >= 0.0 && o.body_width <= 20.0)) {
     err << "visual.face_margin must be in [0, 10] and body_width in [0, 20]";
+  } else if (o.trail_frames < 0 || o.trail_frames > visual::SceneTrail::kMaxFrames ||
+             !(o.trail_threshold_px > 0.0 && o.trail_threshold_px <= 100.0)) {
+    err << "visual.trail_frames must be in [0, " << visual::SceneTrail::kMaxFrames
+        << "] and trail_threshold_px in (0, 100], got " << o.trail_frames << " / "
+        << o.trail_threshold_px;
   }
   if (err.tellp() != 0) return Status::Error(err.str());
   return Status::Ok();
@@ -91,6 +96,7 @@ void VisualRotationEstimator::Reset() {
   prev_pyramid_.clear();
   prev_points_.clear();
   prev_age_.clear();
+  prev_trail_.clear();
 }
 
 cv::Mat VisualRotationEstimator::SubjectMask(const cv::Size& size,
@@ -132,6 +138,7 @@ void VisualRotationEstimator::Refill(const cv::Mat& small,
                           free, 5);
   prev_points_.insert(prev_points_.end(), fresh.begin(), fresh.end());
   prev_age_.resize(prev_points_.size(), 0);
+  prev_trail_.resize(prev_points_.size());
 }
 
 namespace {
@@ -170,6 +177,7 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
   std::vector<visual::BearingPair> pairs;
   std::vector<cv::Point2f> kept;
   std::vector<int> kept_age;
+  std::vector<visual::SceneTrail> kept_trail;
   std::vector<double> weights;
   const cv::Rect2f inside(0.f, 0.f, small.cols - 1.f, small.rows - 1.f);
   for (size_t i = 0; i < next.size(); ++i) {
@@ -191,21 +199,24 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
     pairs.push_back(p);
     kept.push_back(next[i]);
     kept_age.push_back(prev_age_[i]);
+    kept_trail.push_back(prev_trail_[i]);
     // A feature that has moved with the scene for a few frames outvotes a
     // fresh one: the scene it lies on has shown itself to be the scene.
     weights.push_back(1.0 + std::min(prev_age_[i], kMatureAge));
   }
   out->tracked = static_cast<int>(pairs.size());
-  Fit(pairs, weights, stamp, out, &kept, &kept_age);
+  Fit(pairs, weights, stamp, out, &kept, &kept_age, &kept_trail);
   prev_points_.swap(kept);
   prev_age_.swap(kept_age);
+  prev_trail_.swap(kept_trail);
   prev_pyramid_.swap(pyramid);
 }
 
 void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
                                   const std::vector<double>& weights, Time stamp,
                                   VisualRotation* out, std::vector<cv::Point2f>* kept,
-                                  std::vector<int>* kept_age) const {
+                                  std::vector<int>* kept_age,
+                                  std::vector<visual::SceneTrail>* kept_trail) const {
   visual::RotationFit fit;
   const double focal_px = model_.real_focal() * model_.intrinsics().width;
   const double sigma_n = options_.feature_noise_px / focal_px;
@@ -227,7 +238,10 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
                       (out->inliers >= options_.min_inliers_precise &&
                        fit.turn_sigma_px <= options_.max_turn_error_px);
   out->valid = enough && fit.support >= options_.min_inlier_ratio;
-  if (!out->valid) return;  // not trusted: every track is kept as it was
+  if (!out->valid) {  // not trusted: every track is kept as it was
+    for (visual::SceneTrail& t : *kept_trail) t.Clear();
+    return;
+  }
   out->omega = fit.motion.head<3>();
   out->alpha = fit.motion.segment<3>(3);
   out->beta = fit.motion.tail<3>();
@@ -236,13 +250,23 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
   // scene is.
   std::vector<cv::Point2f> in;
   std::vector<int> in_age;
+  std::vector<visual::SceneTrail> in_trail;
   in.reserve(fit.inliers.size());
   for (int i : fit.inliers) {
+    visual::SceneTrail trail = (*kept_trail)[i];
+    if (options_.trail_frames > 0) {
+      const visual::BearingPair& p = pairs[i];
+      const Eigen::Vector3d turn = p.c * out->omega + p.d * out->alpha + p.e * out->beta;
+      const double strayed = trail.Advance(turn, p.b1, p.n2, options_.trail_frames) * focal_px;
+      if (!(strayed <= options_.trail_threshold_px)) continue;
+    }
     in.push_back((*kept)[i]);
     in_age.push_back((*kept_age)[i] + 1);
+    in_trail.push_back(trail);
   }
   kept->swap(in);
   kept_age->swap(in_age);
+  kept_trail->swap(in_trail);
 }
 
 Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
@@ -306,6 +330,7 @@ Status VisualRotationEstimator::Remember(const cv::Mat& gray, Time stamp) {
   prev_stamp_ = stamp;
   prev_points_.clear();
   prev_age_.clear();
+  prev_trail_.clear();
   return Status::Ok();
 }
 

@@ -10,6 +10,7 @@
 #include "steadiface_core/camera/rolling_shutter.h"
 #include "steadiface_core/common/status.h"
 #include "steadiface_core/common/time.h"
+#include "steadiface_core/visual/scene_trail.h"
 
 namespace steadiface {
 namespace visual {
@@ -69,6 +70,15 @@ struct VisualRotationOptions {
   /// face widths wide down to the image's bottom (the body) [-].
   double face_margin = 0.5;
   double body_width = 3.0;
+  /// A feature is dropped once it strays from the scene: once any of its
+  /// sightings over the last `trail_frames` frames, carried to the present
+  /// by the rotations fitted since, lands further than `trail_threshold_px`
+  /// from where it is [count, at most 16; 0: never; full-resolution px]. A
+  /// near object (a face walking up beside the subject) moves with the
+  /// rotation to within the inlier threshold in each frame, but not over
+  /// several.
+  int trail_frames = 8;
+  double trail_threshold_px = 2.0;
 };
 
 Status ValidateVisualRotationOptions(const VisualRotationOptions& options);
@@ -152,7 +162,7 @@ class VisualRotationEstimator {
   // older.
   void Fit(const std::vector<visual::BearingPair>& pairs, const std::vector<double>& weights,
            Time stamp, VisualRotation* out, std::vector<cv::Point2f>* kept,
-           std::vector<int>* kept_age) const;
+           std::vector<int>* kept_age, std::vector<visual::SceneTrail>* kept_trail) const;
   cv::Mat SubjectMask(const cv::Size& size, const cv::Rect2d& face) const;
   cv::Mat Copy(const cv::Mat& gray) const;  // the tracking copy of a frame
   Status CheckGray(const cv::Mat& gray) const;  // 8-bit grey, the camera's size
@@ -167,6 +177,8 @@ class VisualRotationEstimator {
   std::vector<cv::Point2f> prev_points_;  // in the copy
   // Per feature: the frames it has moved with the scene for [count].
   std::vector<int> prev_age_;
+  // Per feature: its recent sightings carried to the present.
+  std::vector<visual::SceneTrail> prev_trail_;
   static constexpr int kMatureAge = 4;  // weight 1 + min(age, 4)
 };
 
