@@ -59,9 +59,9 @@ struct RotationFit {
 /// inlier's residual by its weight too, so that fresh features on a near
 /// object, which fit the rotation to within the threshold, pull the
 /// rotation less. The weights are not scaled: a set of long-known features
-/// leans on the prior less than a fresh set does. `focal_px` turns normalized residuals
-/// into pixels. Deterministic for a given `seed`. False with fewer than
-/// three pairs.
+/// leans on the prior less than a fresh set does. `focal_px` turns
+/// normalized residuals into pixels. Deterministic for a given `seed`.
+/// False with fewer than three pairs.
 bool FitMotion(const std::vector<BearingPair>& pairs, const std::vector<double>& weights,
                double focal_px, double threshold_px, int iterations, const MotionPrior& prior,
                uint64_t seed, RotationFit* fit);
