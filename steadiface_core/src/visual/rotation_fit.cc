@@ -15,7 +15,7 @@ namespace {
 
 // The scene point's bearing in the second frame, Exp(-phi) b1.
 Eigen::Vector3d Moved(const Motion& m, const BearingPair& p) {
-  return ExpSO3(-(p.c * m.head<3>() + p.d * m.segment<3>(3) + p.e * m.tail<3>())) * p.b1;
+  return ExpSO3(-PairTurn(m, p)) * p.b1;
 }
 
 double ErrorPx(const Motion& omega, const BearingPair& p, double focal_px) {
@@ -119,6 +119,10 @@ double TurnSigmaPx(const std::vector<BearingPair>& pairs,
 }
 
 }  // namespace
+
+Eigen::Vector3d PairTurn(const Motion& m, const BearingPair& p) {
+  return p.c * m.head<3>() + p.d * m.segment<3>(3) + p.e * m.tail<3>();
+}
 
 Eigen::Vector2d Predict(const Motion& m, const BearingPair& p) {
   const Eigen::Vector3d b2 = Moved(m, p);

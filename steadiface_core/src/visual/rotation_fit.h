@@ -35,6 +35,10 @@ struct MotionPrior {
   double beta = 0.0;
 };
 
+/// The camera's turn between the rows the pair was seen on, phi = c omega_c
+/// + d alpha + e beta (a rotation vector in the camera) [rad].
+Eigen::Vector3d PairTurn(const Motion& m, const BearingPair& p);
+
 /// Where the scene point lands in the second frame: Exp(-phi) b1 (the scene
 /// stands still; the camera turns by Exp(phi)).
 Eigen::Vector2d Predict(const Motion& m, const BearingPair& p);

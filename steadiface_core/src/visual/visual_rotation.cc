@@ -256,8 +256,9 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
     visual::SceneTrail trail = (*kept_trail)[i];
     if (options_.trail_frames > 0) {
       const visual::BearingPair& p = pairs[i];
-      const Eigen::Vector3d turn = p.c * out->omega + p.d * out->alpha + p.e * out->beta;
-      const double strayed = trail.Advance(turn, p.b1, p.n2, options_.trail_frames) * focal_px;
+      const double strayed =
+          trail.Advance(visual::PairTurn(fit.motion, p), p.b1, p.n2, options_.trail_frames) *
+          focal_px;
       if (!(strayed <= options_.trail_threshold_px)) continue;
     }
     in.push_back((*kept)[i]);
