@@ -258,6 +258,33 @@ TEST(PipelinePresetTest, WithoutAnImuTheVideoGivesTheRotation) {
   }
 }
 
+// The rotation from the video starts on its second frame: the first has
+// no turn across its rows (rolling shutter) until the next one, so it is
+// withheld. Shown uncorrected, as before, the next frame jumped by the
+// first's shutter skew: the layered visible background's largest step was
+// 5.2 px on passer_by and 5.6 px on low_texture (seed 2, 640x360), against
+// 1.2 px with the IMU. The bar: no step over 2 px.
+TEST(PipelinePresetTest, TheVideosFirstFrameIsWithheldAndTheStartDoesNotJump) {
+  for (const std::string preset : {"passer_by", "low_texture"}) {
+    SCOPED_TRACE(preset);
+    auto s = MakeSimulator(preset, [](sim::SimulatorOptions* o) { o->seed = 2; });
+    PipelineOptions po = eval::OptionsFor(*s, eval::Method::kSteadifaceLayered);
+    po.rotation_source = RotationSource::kVisual;
+    std::unique_ptr<eval::Scorecard> card;
+    ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
+    std::vector<StabilizerFrame> frames;
+    ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadifaceLayered, po, false, card.get(),
+                                &frames)
+                    .ok());
+    EXPECT_EQ(frames.size() + 1, static_cast<size_t>(s->num_frames()));
+    const eval::Score sc = card->Compute();
+    std::cout << "[ " << preset << ", rotation from the video, layered ] largest step of the "
+              << "visible background " << sc.visible_background_max_step_px << " px\n";
+    EXPECT_LE(sc.visible_background_max_step_px, 2.0);
+    EXPECT_EQ(sc.undefined_fraction, 0.0);
+  }
+}
+
 TEST(PipelinePresetTest, EveryPresetHasNoUndefinedPixels) {
   for (const std::string& p : {"still", "pan", "occlusion", "two_faces", "turn_away"}) {
     const PresetResult r = Score(p);

@@ -457,6 +457,7 @@ void StabilizerRos::DiagFrames(diagnostic_updater::DiagnosticStatusWrapper& s) {
   s.add("dropped: queue full", c.dropped_queue_full);
   s.add("dropped: old stamp", c.dropped_old_stamp);
   s.add("dropped: refused", c.dropped_pipeline_error);
+  s.add("withheld: the video's first frame", c.withheld);
   s.add("geometry rebuilds", c.rebuilds);
   s.add("last error", w.last_error);
   const uint64_t drops = c.dropped_bad_image + c.dropped_bad_info + c.dropped_no_gyro +

@@ -340,6 +340,12 @@ void StabilizerWrapper::Process(const Pending& p, bool late) {
   }
   if (extrapolated) ++counters_.extrapolated;
   scheduler_.OnFrameDone(stamp);
+  if (frame.withheld) {
+    // The rotation from the video starts: this frame's rows get their turn
+    // from the next frame, so it is not published (PipelineFrame::withheld).
+    ++counters_.withheld;
+    return;
+  }
   sink_->OnFrameProcessed(frame, *pipeline_);
   if (!pipelined) {
     Publish(p, frame, image, extrapolated, false, started);

@@ -175,6 +175,7 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
     PipelineFrame out;
     s = p->ProcessFrame(frame, stamp, nullptr, 0.0, &out);
     if (!s.ok()) return Status::Error("frame " + std::to_string(i) + ": " + s.message());
+    if (out.withheld) continue;  // not published: not scored, not rendered
     card->Add(i, MakeFrameWarp(out, *p, render));
     if (quality != nullptr) {
       s = quality->Add(i, *p, out, frame);

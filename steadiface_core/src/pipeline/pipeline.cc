@@ -203,6 +203,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
       video_newest_ = true;
       HandBackToGyro();
     }
+    f.withheld = f.rotation_from_video && !has_visual_mid_;
     visual_mid_ = timing_.RowTime(stamp, 0.5 * (k.height - 1));
     has_visual_mid_ = true;
   }
@@ -250,6 +251,9 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     *out = std::move(f);
     return s;
   }
+  // A withheld frame still sets the stabilizer's and the warp's state (its
+  // middle row's rotation is known): only its picture is not shown.
+  if (f.withheld) f.output.release();
   f.timings.total_ms = MsSince(t0);
   *out = std::move(f);
   return Status::Ok();

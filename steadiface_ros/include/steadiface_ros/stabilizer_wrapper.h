@@ -81,6 +81,7 @@ struct WrapperCounters {
   uint64_t extrapolated = 0;            ///< processed with extrapolated gyro
   uint64_t passthrough = 0;             ///< published unstabilized (no IMU)
   uint64_t from_video = 0;              ///< rotation from the video (visual, or auto without IMU)
+  uint64_t withheld = 0;                ///< the video's first frame (no turn across its rows yet)
   uint64_t accel_in = 0;                ///< IMU messages with an accelerometer reading
   uint64_t imu_rejected = 0;            ///< non-finite, implausible, duplicate, out of order
   uint64_t imu_gaps = 0;                ///< gaps longer than imu_gap_warn

@@ -180,6 +180,7 @@ void CountersJson(const steadiface_ros::WrapperStatus& ws, const StateSeries& t,
       << ", \"old_stamp\": " << ws.counters.dropped_old_stamp
       << ", \"refused\": " << ws.counters.dropped_pipeline_error << "}"
       << ",\n  \"passthrough_no_imu\": " << ws.counters.passthrough
+      << ",\n  \"withheld_first_from_video\": " << ws.counters.withheld
       << ",\n  \"extrapolated\": " << ws.counters.extrapolated
       << ",\n  \"protrusion_searches\": " << ws.stabilizer.protrusion_searches
       << ",\n  \"previous_warp_fallbacks\": "

@@ -159,6 +159,12 @@ struct PipelineFrame {
   /// without IMU data), and what the video gave.
   bool rotation_from_video = false;
   VisualRotation visual;
+  /// The first frame of the rotation from the video (at the start, or after
+  /// Reset()): no turn is known across its rows until the next frame, so it
+  /// is not to be shown (output empty). Its middle row's rotation is known:
+  /// the stabilizer and the warp take it as their first frame. Shown
+  /// uncorrected, it made the next frame jump by its rolling shutter's skew.
+  bool withheld = false;
   /// The clock offset correction the timeline applied to this frame, on top
   /// of imu/time_offset (gyro_video_check/apply_offset; else 0) [s].
   double imu_offset_applied_s = 0.0;
