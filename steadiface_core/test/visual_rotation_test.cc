@@ -295,6 +295,50 @@ TEST(VisualRotationTest, MatchesTheTrueRotationOnRenderedSequences) {
   }
 }
 
+// two_faces: a second face walks up to 0.4 m beside the subject. Its
+// features fit each frame's turn to within the inlier threshold and are
+// dropped only once they stray over several frames; found again on it at
+// once, they kept pulling the turn. Where three features strayed no fresh
+// one is taken for a second (visual.stray_*): the turn's error per frame,
+// seed 1 at 640x360, goes from 0.78 px to 0.25 px.
+TEST(VisualRotationTest, ANearFacesFeaturesAreNotFoundAgainWhereTheyStrayed) {
+  auto s = MakeSimulator("two_faces");
+  CameraModel m;
+  ASSERT_TRUE(CameraModel::Create(s->intrinsics(), CameraModelOptions(), &m).ok());
+  auto turn_error_px = [&](double stray_hold_s) {
+    VisualRotationOptions o;
+    o.stray_hold_s = stray_hold_s;
+    std::unique_ptr<VisualRotationEstimator> e;
+    EXPECT_TRUE(VisualRotationEstimator::Create(m, s->timing(), o, &e).ok());
+    cv::Mat frame, grey;
+    sim::SimTruth prev, t;
+    double se = 0.0;
+    int n = 0;
+    for (int i = 0; i < s->num_frames(); ++i) {
+      EXPECT_TRUE(s->Render(i, &frame, &t).ok());
+      cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
+      const double w = 1.2 * t.face_scale_px;
+      const cv::Rect2d face(t.head_px.x() - w / 2, t.head_px.y() - w / 2, w, w);
+      VisualRotation r;
+      EXPECT_TRUE(e->Process(grey, t.stamp, face, &r).ok());
+      if (i > 0) {
+        double ta = 0.0, tb = 0.0;
+        const Eigen::Vector3d truth = TrueTurn(*s, prev.stamp, t.stamp, &ta, &tb);
+        const double u0 = ta - ToSeconds(r.stamp), u1 = tb - ToSeconds(r.stamp);
+        se += (r.Turn(u0, u1) - truth).squaredNorm();
+        ++n;
+      }
+      prev = t;
+    }
+    return std::sqrt(se / n) * s->intrinsics().fx;
+  };
+  const double off = turn_error_px(0.0), on = turn_error_px(VisualRotationOptions().stray_hold_s);
+  std::cout << "[ two_faces ] the turn's error per frame: " << off << " px, " << on
+            << " px where strays are not refilled\n";
+  EXPECT_LT(on, 0.5 * off);
+  EXPECT_LT(on, 0.35);
+}
+
 TEST(VisualRotationTest, ATexturelessViewIsNotTrustedAndHoldsStill) {
   CameraModel m;
   ASSERT_TRUE(CameraModel::Create(IntrinsicsFromHorizontalFov(640, 360, 1.0),

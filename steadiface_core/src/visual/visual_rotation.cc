@@ -61,6 +61,12 @@ Status ValidateVisualRotationOptions(const VisualRotationOptions& o) {
     err << "visual.trail_frames must be in [0, " << visual::SceneTrail::kMaxFrames
         << "] and trail_threshold_px in (0, 100], got " << o.trail_frames << " / "
         << o.trail_threshold_px;
+  } else if (!(o.stray_hold_s >= 0.0 && o.stray_hold_s <= 10.0) ||
+             !(o.stray_radius_px >= 0.0 && o.stray_radius_px <= 640.0) ||
+             o.stray_min_count < 1 || o.stray_min_count > 100) {
+    err << "visual.stray_hold_s must be in [0, 10], stray_radius_px in [0, 640] and "
+           "stray_min_count in [1, 100], got "
+        << o.stray_hold_s << " / " << o.stray_radius_px << " / " << o.stray_min_count;
   }
   if (err.tellp() != 0) return Status::Error(err.str());
   return Status::Ok();
@@ -97,6 +103,7 @@ void VisualRotationEstimator::Reset() {
   prev_points_.clear();
   prev_age_.clear();
   prev_trail_.clear();
+  strays_.clear();
 }
 
 cv::Mat VisualRotationEstimator::SubjectMask(const cv::Size& size,
@@ -131,6 +138,7 @@ void VisualRotationEstimator::Refill(const cv::Mat& small,
   const int r = static_cast<int>(std::ceil(options_.min_distance_px));
   for (const cv::Point2f& p : prev_points_)
     cv::circle(free, p, r, cv::Scalar(0), -1);
+  BlockStrays(&free);
   std::vector<cv::Point2f> fresh;
   const int want =
       options_.max_features - static_cast<int>(prev_points_.size());
@@ -205,7 +213,9 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
     weights.push_back(1.0 + std::min(prev_age_[i], kMatureAge));
   }
   out->tracked = static_cast<int>(pairs.size());
-  Fit(pairs, weights, stamp, out, &kept, &kept_age, &kept_trail);
+  std::vector<cv::Point2f> strays;
+  Fit(pairs, weights, stamp, out, &kept, &kept_age, &kept_trail, &strays);
+  RememberStrays(strays, stamp);
   prev_points_.swap(kept);
   prev_age_.swap(kept_age);
   prev_trail_.swap(kept_trail);
@@ -216,7 +226,8 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
                                   const std::vector<double>& weights, Time stamp,
                                   VisualRotation* out, std::vector<cv::Point2f>* kept,
                                   std::vector<int>* kept_age,
-                                  std::vector<visual::SceneTrail>* kept_trail) const {
+                                  std::vector<visual::SceneTrail>* kept_trail,
+                                  std::vector<cv::Point2f>* strays) const {
   visual::RotationFit fit;
   const double focal_px = model_.real_focal() * model_.intrinsics().width;
   const double sigma_n = options_.feature_noise_px / focal_px;
@@ -259,7 +270,10 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
       const double strayed =
           trail.Advance(visual::PairTurn(fit.motion, p), p.b1, p.n2, options_.trail_frames) *
           focal_px;
-      if (!(strayed <= options_.trail_threshold_px)) continue;
+      if (!(strayed <= options_.trail_threshold_px)) {
+        strays->push_back((*kept)[i]);
+        continue;
+      }
     }
     in.push_back((*kept)[i]);
     in_age.push_back((*kept_age)[i] + 1);
@@ -268,6 +282,35 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
   kept->swap(in);
   kept_age->swap(in_age);
   kept_trail->swap(in_trail);
+}
+
+void VisualRotationEstimator::BlockStrays(cv::Mat* free) const {
+  // A near object strays as a group; a lone stray is the noise of one
+  // track, and the scene around it is kept.
+  const int rs = static_cast<int>(std::ceil(options_.stray_radius_px));
+  const float r2 = static_cast<float>(options_.stray_radius_px * options_.stray_radius_px);
+  for (const auto& p : strays_) {
+    int near = 0;
+    for (const auto& q : strays_) {
+      const cv::Point2f d = p.first - q.first;
+      if (d.dot(d) <= r2) ++near;
+    }
+    if (near >= options_.stray_min_count) cv::circle(*free, p.first, rs, cv::Scalar(0), -1);
+  }
+}
+
+void VisualRotationEstimator::RememberStrays(const std::vector<cv::Point2f>& strays,
+                                             Time stamp) {
+  if (!(options_.stray_hold_s > 0.0)) return;
+  for (const cv::Point2f& p : strays) strays_.emplace_back(p, stamp);
+  const Time oldest = stamp - FromSeconds(options_.stray_hold_s);
+  strays_.erase(std::remove_if(strays_.begin(), strays_.end(),
+                               [oldest](const std::pair<cv::Point2f, Time>& s) {
+                                 return s.second < oldest;
+                               }),
+                strays_.end());
+  // Bounded: a few frames' worth of every feature straying at once.
+  if (strays_.size() > kMaxStrays) strays_.erase(strays_.begin(), strays_.end() - kMaxStrays);
 }
 
 Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,

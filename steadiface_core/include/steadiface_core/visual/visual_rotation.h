@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -79,6 +80,16 @@ struct VisualRotationOptions {
   /// several.
   int trail_frames = 8;
   double trail_threshold_px = 2.0;
+  /// Where features strayed from the scene, no fresh feature is taken for
+  /// `stray_hold_s` [s] (0: off) within `stray_radius_px` of each [px on
+  /// the tracking copy], once at least `stray_min_count` of them (itself
+  /// included) strayed within that radius over that time [count]. A near
+  /// object's features, dropped as they stray, were otherwise found again
+  /// on it at once, each pulling the turn for a few frames before it
+  /// strayed in turn; a lone stray is one track's noise.
+  double stray_hold_s = 1.0;
+  double stray_radius_px = 40.0;
+  int stray_min_count = 3;
 };
 
 Status ValidateVisualRotationOptions(const VisualRotationOptions& options);
@@ -162,7 +173,12 @@ class VisualRotationEstimator {
   // older.
   void Fit(const std::vector<visual::BearingPair>& pairs, const std::vector<double>& weights,
            Time stamp, VisualRotation* out, std::vector<cv::Point2f>* kept,
-           std::vector<int>* kept_age, std::vector<visual::SceneTrail>* kept_trail) const;
+           std::vector<int>* kept_age, std::vector<visual::SceneTrail>* kept_trail,
+           std::vector<cv::Point2f>* strays) const;
+  // Keeps where features strayed this frame, for stray_hold_s.
+  void RememberStrays(const std::vector<cv::Point2f>& strays, Time stamp);
+  // Zeroes `free` around the strays kept that have company.
+  void BlockStrays(cv::Mat* free) const;
   cv::Mat SubjectMask(const cv::Size& size, const cv::Rect2d& face) const;
   cv::Mat Copy(const cv::Mat& gray) const;  // the tracking copy of a frame
   Status CheckGray(const cv::Mat& gray) const;  // 8-bit grey, the camera's size
@@ -180,6 +196,10 @@ class VisualRotationEstimator {
   // Per feature: its recent sightings carried to the present.
   std::vector<visual::SceneTrail> prev_trail_;
   static constexpr int kMatureAge = 4;  // weight 1 + min(age, 4)
+  // Where features strayed recently (in the copy), and when; at most
+  // kMaxStrays.
+  std::vector<std::pair<cv::Point2f, Time>> strays_;
+  static constexpr size_t kMaxStrays = 512;
 };
 
 }  // namespace steadiface
