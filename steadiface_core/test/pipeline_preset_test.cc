@@ -285,6 +285,30 @@ TEST(PipelinePresetTest, TheVideosFirstFrameIsWithheldAndTheStartDoesNotJump) {
   }
 }
 
+// two_faces: a second face walks up to 0.4 m beside the subject, and the
+// visible background is only the view's left quarter by the end. Its
+// features fit each frame's turn, and were found again on it as soon as the
+// scene trail dropped them: the layered visible background with the video
+// was 1.77x the IMU's gyro-only on seed 1 (bar: 1.5x). Measured now: 1.1x.
+TEST(PipelinePresetTest, ANearSecondFaceDoesNotTurnTheVideosRotation) {
+  auto s = MakeSimulator("two_faces");
+  eval::Score layered_video, gyro_imu;
+  for (const eval::Method method : {eval::Method::kGyroOnly, eval::Method::kSteadifaceLayered}) {
+    PipelineOptions po = eval::OptionsFor(*s, method);
+    const bool video = method == eval::Method::kSteadifaceLayered;
+    if (video) po.rotation_source = RotationSource::kVisual;
+    std::unique_ptr<eval::Scorecard> card;
+    ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
+    ASSERT_TRUE(eval::RunMethod(*s, method, po, false, card.get(), nullptr).ok());
+    (video ? layered_video : gyro_imu) = card->Compute();
+  }
+  std::cout << "[ two_faces ] visible background: layered with the video "
+            << layered_video.visible_background_jitter_px << " px, gyro-only with the IMU "
+            << gyro_imu.visible_background_jitter_px << " px\n";
+  EXPECT_LE(layered_video.visible_background_jitter_px,
+            1.5 * gyro_imu.visible_background_jitter_px);
+}
+
 TEST(PipelinePresetTest, EveryPresetHasNoUndefinedPixels) {
   for (const std::string& p : {"still", "pan", "occlusion", "two_faces", "turn_away"}) {
     const PresetResult r = Score(p);
