@@ -509,6 +509,12 @@ void StabilizerRos::DiagGyroVideo(diagnostic_updater::DiagnosticStatusWrapper& s
   }
   if (!pipeline_options_.gyro_video_check.enabled) {
     s.summary(diagnostic_msgs::DiagnosticStatus::OK, "check off (gyro_video_check/enabled)");
+  } else if (w.rotation_source == "visual") {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK,
+              "not used: rotation_source is visual (no gyro to check)");
+  } else if (w.last_from_video && !c.judged) {
+    s.summary(diagnostic_msgs::DiagnosticStatus::OK,
+              "not checked while the rotation comes from the video (no IMU data)");
   } else if (!c.judged) {
     std::snprintf(text, sizeof(text),
                   "not enough image motion yet to judge (%d frame pairs, %.1f px)", c.pairs,

@@ -221,9 +221,15 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     last_face_box_ = cv::Rect2d();
   }
   // The gyro-vs-video check (never changes the pose), outside the face.
+  // It checks the gyro: a frame rotated by the video ends no pair (the
+  // video against itself would always agree).
   if (check_ != nullptr) {
     const auto t_check = std::chrono::steady_clock::now();
-    check_->Process(grey, stamp, timeline_, f.face.located() ? f.face.box : cv::Rect2d());
+    if (f.rotation_from_video) {
+      check_->SkipFrame();
+    } else {
+      check_->Process(grey, stamp, timeline_, f.face.located() ? f.face.box : cv::Rect2d());
+    }
     f.gyro_video_check = check_->result();
     f.timings.check_ms = MsSince(t_check);
   }

@@ -107,6 +107,9 @@ class GyroVideoCheck {
   /// cover the frame's rows plus the offset range (else the pair is skipped).
   void Process(const cv::Mat& image, Time stamp,
                const OrientationTimeline& timeline, const cv::Rect2d& face_box);
+  /// A frame whose rotation is not the gyro's (taken from the video): the
+  /// pair that would end at it is not formed; the window is kept.
+  void SkipFrame() { has_prev_ = false; }
   void Reset();
   const GyroVideoCheckResult& result() const { return result_; }
 
