@@ -220,19 +220,7 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   } else if (f.face.state == TrackingState::kSearching) {
     last_face_box_ = cv::Rect2d();
   }
-  // The gyro-vs-video check (never changes the pose), outside the face.
-  // It checks the gyro: a frame rotated by the video ends no pair (the
-  // video against itself would always agree).
-  if (check_ != nullptr) {
-    const auto t_check = std::chrono::steady_clock::now();
-    if (f.rotation_from_video) {
-      check_->SkipFrame();
-    } else {
-      check_->Process(grey, stamp, timeline_, f.face.located() ? f.face.box : cv::Rect2d());
-    }
-    f.gyro_video_check = check_->result();
-    f.timings.check_ms = MsSince(t_check);
-  }
+  CheckStep(grey, stamp, &f);
   // Stabilizer, within this frame's crop.
   const auto t_stab = std::chrono::steady_clock::now();
   stabilizer_->SetCropRatio(crop_->crop_ratio());
@@ -263,6 +251,21 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
   f.timings.total_ms = MsSince(t0);
   *out = std::move(f);
   return Status::Ok();
+}
+
+void Pipeline::CheckStep(const cv::Mat& grey, Time stamp, PipelineFrame* f) {
+  // The gyro-vs-video check (never changes the pose), outside the face.
+  // It checks the gyro: a frame rotated by the video ends no pair (the
+  // video against itself would always agree).
+  if (check_ == nullptr) return;
+  const auto t_check = std::chrono::steady_clock::now();
+  if (f->rotation_from_video) {
+    check_->SkipFrame();
+  } else {
+    check_->Process(grey, stamp, timeline_, f->face.located() ? f->face.box : cv::Rect2d());
+  }
+  f->gyro_video_check = check_->result();
+  f->timings.check_ms = MsSince(t_check);
 }
 
 const FaceObservation* Pipeline::FaceStep(const cv::Mat& image, Time stamp,

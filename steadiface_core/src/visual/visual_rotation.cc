@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -100,9 +101,7 @@ VisualRotationEstimator::VisualRotationEstimator(
 void VisualRotationEstimator::Reset() {
   prev_.release();
   prev_pyramid_.clear();
-  prev_points_.clear();
-  prev_age_.clear();
-  prev_trail_.clear();
+  tracks_.Clear();
   strays_.clear();
 }
 
@@ -132,21 +131,32 @@ cv::Mat VisualRotationEstimator::SubjectMask(const cv::Size& size,
 
 void VisualRotationEstimator::Refill(const cv::Mat& small,
                                      const cv::Mat& mask) {
-  if (static_cast<int>(prev_points_.size()) >= options_.max_features / 2)
+  if (static_cast<int>(tracks_.size()) >= options_.max_features / 2)
     return;
   cv::Mat free = mask.clone();
   const int r = static_cast<int>(std::ceil(options_.min_distance_px));
-  for (const cv::Point2f& p : prev_points_)
+  for (const cv::Point2f& p : tracks_.points)
     cv::circle(free, p, r, cv::Scalar(0), -1);
   BlockStrays(&free);
   std::vector<cv::Point2f> fresh;
   const int want =
-      options_.max_features - static_cast<int>(prev_points_.size());
+      options_.max_features - static_cast<int>(tracks_.size());
   cv::goodFeaturesToTrack(small, fresh, want, 0.01, options_.min_distance_px,
                           free, 5);
-  prev_points_.insert(prev_points_.end(), fresh.begin(), fresh.end());
-  prev_age_.resize(prev_points_.size(), 0);
-  prev_trail_.resize(prev_points_.size());
+  for (const cv::Point2f& p : fresh) tracks_.Add(p, 0, visual::SceneTrail());
+}
+
+void VisualRotationEstimator::Tracks::Clear() {
+  points.clear();
+  age.clear();
+  trail.clear();
+}
+
+void VisualRotationEstimator::Tracks::Add(const cv::Point2f& p, int a,
+                                          const visual::SceneTrail& t) {
+  points.push_back(p);
+  age.push_back(a);
+  trail.push_back(t);
 }
 
 namespace {
@@ -177,15 +187,13 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
   std::vector<cv::Mat> pyramid;
   cv::buildOpticalFlowPyramid(small, pyramid, cv::Size(w, w), options_.klt_levels);
   cv::calcOpticalFlowPyrLK(
-      prev_pyramid_, pyramid, prev_points_, next, status, error, cv::Size(w, w),
+      prev_pyramid_, pyramid, tracks_.points, next, status, error, cv::Size(w, w),
       options_.klt_levels,
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30,
                        0.01),
       0, options_.min_texture);
   std::vector<visual::BearingPair> pairs;
-  std::vector<cv::Point2f> kept;
-  std::vector<int> kept_age;
-  std::vector<visual::SceneTrail> kept_trail;
+  Tracks kept;
   std::vector<double> weights;
   const cv::Rect2f inside(0.f, 0.f, small.cols - 1.f, small.rows - 1.f);
   for (size_t i = 0; i < next.size(); ++i) {
@@ -194,10 +202,10 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
       continue;
     }
     visual::BearingPair p;
-    const Eigen::Vector2d r1 = Ray(model_, scale_, prev_points_[i]);
+    const Eigen::Vector2d r1 = Ray(model_, scale_, tracks_.points[i]);
     p.b1 = Eigen::Vector3d(r1.x(), r1.y(), 1.0);
     p.n2 = Ray(model_, scale_, next[i]);
-    const double y1 = (prev_points_[i].y + 0.5) / scale_ - 0.5;
+    const double y1 = (tracks_.points[i].y + 0.5) / scale_ - 0.5;
     const double y2 = (next[i].y + 0.5) / scale_ - 0.5;
     const double t1 = ToSeconds(timing_.RowTime(prev_stamp_, y1) - out->stamp);
     const double t2 = ToSeconds(timing_.RowTime(stamp, y2) - out->stamp);
@@ -205,28 +213,22 @@ void VisualRotationEstimator::Track(const cv::Mat& small, const cv::Mat& mask,
     p.d = 0.5 * (t2 * t2 - t1 * t1);
     p.e = (t2 * t2 * t2 - t1 * t1 * t1) / 6.0;
     pairs.push_back(p);
-    kept.push_back(next[i]);
-    kept_age.push_back(prev_age_[i]);
-    kept_trail.push_back(prev_trail_[i]);
+    kept.Add(next[i], tracks_.age[i], tracks_.trail[i]);
     // A feature that has moved with the scene for a few frames outvotes a
     // fresh one: the scene it lies on has shown itself to be the scene.
-    weights.push_back(1.0 + std::min(prev_age_[i], kMatureAge));
+    weights.push_back(1.0 + std::min(tracks_.age[i], kMatureAge));
   }
   out->tracked = static_cast<int>(pairs.size());
   std::vector<cv::Point2f> strays;
-  Fit(pairs, weights, stamp, out, &kept, &kept_age, &kept_trail, &strays);
+  Fit(pairs, weights, stamp, out, &kept, &strays);
   RememberStrays(strays, stamp);
-  prev_points_.swap(kept);
-  prev_age_.swap(kept_age);
-  prev_trail_.swap(kept_trail);
+  std::swap(tracks_, kept);
   prev_pyramid_.swap(pyramid);
 }
 
 void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
                                   const std::vector<double>& weights, Time stamp,
-                                  VisualRotation* out, std::vector<cv::Point2f>* kept,
-                                  std::vector<int>* kept_age,
-                                  std::vector<visual::SceneTrail>* kept_trail,
+                                  VisualRotation* out, Tracks* kept,
                                   std::vector<cv::Point2f>* strays) const {
   visual::RotationFit fit;
   const double focal_px = model_.real_focal() * model_.intrinsics().width;
@@ -250,7 +252,7 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
                        fit.turn_sigma_px <= options_.max_turn_error_px);
   out->valid = enough && fit.support >= options_.min_inlier_ratio;
   if (!out->valid) {  // not trusted: every track is kept as it was
-    for (visual::SceneTrail& t : *kept_trail) t.Clear();
+    for (visual::SceneTrail& t : kept->trail) t.Clear();
     return;
   }
   out->omega = fit.motion.head<3>();
@@ -259,29 +261,22 @@ void VisualRotationEstimator::Fit(const std::vector<visual::BearingPair>& pairs,
   // Keep tracking the features that moved with the camera, one frame
   // older: a passer-by's are dropped, and fresh ones are found where the
   // scene is.
-  std::vector<cv::Point2f> in;
-  std::vector<int> in_age;
-  std::vector<visual::SceneTrail> in_trail;
-  in.reserve(fit.inliers.size());
+  Tracks in;
   for (int i : fit.inliers) {
-    visual::SceneTrail trail = (*kept_trail)[i];
+    visual::SceneTrail trail = kept->trail[i];
     if (options_.trail_frames > 0) {
       const visual::BearingPair& p = pairs[i];
       const double strayed =
           trail.Advance(visual::PairTurn(fit.motion, p), p.b1, p.n2, options_.trail_frames) *
           focal_px;
       if (!(strayed <= options_.trail_threshold_px)) {
-        strays->push_back((*kept)[i]);
+        strays->push_back(kept->points[i]);
         continue;
       }
     }
-    in.push_back((*kept)[i]);
-    in_age.push_back((*kept_age)[i] + 1);
-    in_trail.push_back(trail);
+    in.Add(kept->points[i], kept->age[i] + 1, trail);
   }
-  kept->swap(in);
-  kept_age->swap(in_age);
-  kept_trail->swap(in_trail);
+  std::swap(*kept, in);
 }
 
 void VisualRotationEstimator::BlockStrays(cv::Mat* free) const {
@@ -327,8 +322,8 @@ Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
   const cv::Mat small = Copy(gray);
   const cv::Mat mask = SubjectMask(small.size(), face);
   // After Remember() the previous frame has a picture but no features yet.
-  if (!prev_.empty() && prev_points_.empty()) Refill(prev_, mask);
-  const bool track = !prev_.empty() && !prev_points_.empty();
+  if (!prev_.empty() && tracks_.empty()) Refill(prev_, mask);
+  const bool track = !prev_.empty() && !tracks_.empty();
   if (track) {
     const double mid = 0.5 * (k.height - 1);
     out->stamp =
@@ -372,9 +367,7 @@ Status VisualRotationEstimator::Remember(const cv::Mat& gray, Time stamp) {
   prev_ = Copy(gray);
   prev_pyramid_.clear();
   prev_stamp_ = stamp;
-  prev_points_.clear();
-  prev_age_.clear();
-  prev_trail_.clear();
+  tracks_.Clear();
   return Status::Ok();
 }
 

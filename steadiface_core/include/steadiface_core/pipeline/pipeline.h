@@ -270,6 +270,8 @@ class Pipeline {
                                   const std::vector<Eigen::Vector2d>* external,
                                   double external_confidence, cv::Mat* grey,
                                   FaceObservation* observation, PipelineFrame* f);
+  // The gyro-vs-video check on this frame (skipped when the video rotated it).
+  void CheckStep(const cv::Mat& grey, Time stamp, PipelineFrame* f);
   Status WarpStep(const cv::Mat& image, Time stamp, const FaceObservation* obs,
                   PipelineFrame* f);
   // WarpStep in composite mode: both layers' pictures and their composite.

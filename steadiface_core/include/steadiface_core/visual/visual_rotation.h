@@ -171,9 +171,19 @@ class VisualRotationEstimator {
   // The rotation fitted to the tracked pairs (into *out); when trusted,
   // the tracks `kept` (with their ages) narrowed to its inliers, a frame
   // older.
+  // The features tracked, one entry per feature in each vector (the points
+  // stay contiguous for KLT).
+  struct Tracks {
+    std::vector<cv::Point2f> points;  // in the copy
+    std::vector<int> age;  // the frames each has moved with the scene for
+    std::vector<visual::SceneTrail> trail;  // its sightings carried to the present
+    size_t size() const { return points.size(); }
+    bool empty() const { return points.empty(); }
+    void Clear();
+    void Add(const cv::Point2f& p, int a, const visual::SceneTrail& t);
+  };
   void Fit(const std::vector<visual::BearingPair>& pairs, const std::vector<double>& weights,
-           Time stamp, VisualRotation* out, std::vector<cv::Point2f>* kept,
-           std::vector<int>* kept_age, std::vector<visual::SceneTrail>* kept_trail,
+           Time stamp, VisualRotation* out, Tracks* kept,
            std::vector<cv::Point2f>* strays) const;
   // Keeps where features strayed this frame, for stray_hold_s.
   void RememberStrays(const std::vector<cv::Point2f>& strays, Time stamp);
@@ -190,11 +200,7 @@ class VisualRotationEstimator {
   cv::Mat prev_;        // the previous copy
   std::vector<cv::Mat> prev_pyramid_;  // its KLT pyramid (empty: not built yet)
   Time prev_stamp_;
-  std::vector<cv::Point2f> prev_points_;  // in the copy
-  // Per feature: the frames it has moved with the scene for [count].
-  std::vector<int> prev_age_;
-  // Per feature: its recent sightings carried to the present.
-  std::vector<visual::SceneTrail> prev_trail_;
+  Tracks tracks_;  // the previous frame's features
   static constexpr int kMatureAge = 4;  // weight 1 + min(age, 4)
   // Where features strayed recently (in the copy), and when; at most
   // kMaxStrays.
