@@ -368,6 +368,7 @@ Status VisualRotationEstimator::Remember(const cv::Mat& gray, Time stamp) {
   prev_pyramid_.clear();
   prev_stamp_ = stamp;
   tracks_.Clear();
+  strays_.clear();  // where they were is out of date
   return Status::Ok();
 }
 

@@ -168,9 +168,6 @@ class VisualRotationEstimator {
   // fitted, the features that fit kept.
   void Track(const cv::Mat& small, const cv::Mat& mask, Time stamp,
              VisualRotation* out);
-  // The rotation fitted to the tracked pairs (into *out); when trusted,
-  // the tracks `kept` (with their ages) narrowed to its inliers, a frame
-  // older.
   // The features tracked, one entry per feature in each vector (the points
   // stay contiguous for KLT).
   struct Tracks {
@@ -182,6 +179,9 @@ class VisualRotationEstimator {
     void Clear();
     void Add(const cv::Point2f& p, int a, const visual::SceneTrail& t);
   };
+  // The rotation fitted to the tracked pairs (into *out); when trusted,
+  // the tracks `kept` narrowed to its inliers that stay on their trails, a
+  // frame older, and where the others strayed into *strays.
   void Fit(const std::vector<visual::BearingPair>& pairs, const std::vector<double>& weights,
            Time stamp, VisualRotation* out, Tracks* kept,
            std::vector<cv::Point2f>* strays) const;
