@@ -285,6 +285,31 @@ TEST(PipelinePresetTest, TheVideosFirstFrameIsWithheldAndTheStartDoesNotJump) {
   }
 }
 
+// The withheld first frame is not drawn (its mesh is still computed, as
+// the warp's state), in global and layered mode; the frames after it are.
+TEST(PipelinePresetTest, TheVideosWithheldFirstFrameIsNotDrawn) {
+  auto s = MakeSimulator("walk");
+  for (const eval::Method method : {eval::Method::kSteadiface, eval::Method::kSteadifaceLayered}) {
+    PipelineOptions po = eval::OptionsFor(*s, method);
+    po.rotation_source = RotationSource::kVisual;
+    po.render_output = true;
+    std::unique_ptr<Pipeline> p;
+    ASSERT_TRUE(Pipeline::Create(s->intrinsics(), po, &p).ok());
+    for (int i = 0; i < 3; ++i) {
+      SCOPED_TRACE(i);
+      cv::Mat image;
+      sim::SimTruth truth;
+      ASSERT_TRUE(s->Render(i, &image, &truth).ok());
+      PipelineFrame out;
+      ASSERT_TRUE(p->ProcessFrame(image, s->Truth(i).stamp, nullptr, 0.0, &out).ok());
+      EXPECT_EQ(out.withheld, i == 0);
+      EXPECT_EQ(out.output.empty(), i == 0);
+      EXPECT_GT(out.timings.mesh_ms, 0.0);
+      if (i == 0) EXPECT_EQ(out.timings.remap_ms, 0.0);
+    }
+  }
+}
+
 // two_faces: a second face walks up to 0.4 m beside the subject, and the
 // visible background is only the view's left quarter by the end. Its
 // features fit each frame's turn, and were found again on it as soon as the

@@ -209,7 +209,9 @@ Status Pipeline::ProcessFrame(const cv::Mat& image, Time stamp,
     return s;
   }
   // A withheld frame still sets the stabilizer's and the warp's state (its
-  // middle row's rotation is known): only its picture is not shown.
+  // middle row's rotation is known): only its picture is not shown (global
+  // and layered do not draw it; the composite draws it, as its matte and
+  // plate learn from it).
   if (f.withheld) f.output.release();
   f.timings.total_ms = MsSince(t0);
   *out = std::move(f);
@@ -274,7 +276,8 @@ Status Pipeline::WarpStep(const cv::Mat& image, Time stamp, const FaceObservatio
   PipelineFrame& f = *out;
   Status s;
   const bool layered = options_.warp.mode == WarpMode::kLayered;
-  const bool render = options_.render_output && !defer_render_;
+  // A withheld frame sets the warp's state (its mesh) but is not drawn.
+  const bool render = options_.render_output && !defer_render_ && !f.withheld;
   f.output_intrinsics = warper_->output_geometry().VirtualIntrinsics(
       layered && f.stabilizer.background.valid ? f.stabilizer.background.t : f.stabilizer.t);
   if (layered) {
@@ -310,7 +313,7 @@ Status Pipeline::WarpStep(const cv::Mat& image, Time stamp, const FaceObservatio
     f.timings.mesh_ms = warper_->timings().mesh_ms;
     f.timings.maps_ms = warper_->timings().maps_ms;
     f.timings.remap_ms = warper_->timings().remap_ms;
-  } else if (defer_render_) {
+  } else if (defer_render_ || (f.withheld && options_.render_output)) {
     s = warper_->ComputeMesh(f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows);
     f.timings.mesh_ms = warper_->timings().mesh_ms;
   }
