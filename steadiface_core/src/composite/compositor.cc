@@ -5,16 +5,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "composite/row_stripes.h"
+#include "steadiface_core/common/stopwatch.h"
 
 namespace steadiface {
 namespace {
 
 // A fill that shows through the subject by less than this is not made.
 constexpr float kFillNone = 1.0f / 64.0f;
-
-double MsSince(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
 
 }  // namespace
 

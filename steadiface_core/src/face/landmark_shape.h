@@ -12,13 +12,13 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "steadiface_core/common/stopwatch.h"
+
 namespace steadiface {
 namespace face_internal {
 
 using Clock = std::chrono::steady_clock;
-inline double MsSince(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
+using ::steadiface::MsSince;
 
 inline Eigen::Vector2d Mean(const std::vector<Eigen::Vector2d>& p) {
   Eigen::Vector2d c = Eigen::Vector2d::Zero();

@@ -7,6 +7,8 @@
 
 #include <Eigen/Dense>
 
+#include "steadiface_core/common/stopwatch.h"
+
 namespace steadiface {
 namespace {
 
@@ -219,8 +221,7 @@ void LayerBlend::Blend(const std::vector<Eigen::Vector2f>& subject,
   std::vector<double> added;
   CellRatios(cols_, rows_, u_, v_, *source, &background, &added);
   if (!added.empty()) r.min_added_ratio = *std::min_element(added.begin(), added.end());
-  r.solve_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  r.solve_ms = MsSince(start);
   *report = r;
 }
 

@@ -5,16 +5,12 @@
 #include <cmath>
 
 #include "steadiface_core/common/grey.h"
+#include "steadiface_core/common/stopwatch.h"
 #include "steadiface_core/view/crop_need.h"
 #include "steadiface_core/warp/mesh_sampler.h"
 
 namespace steadiface {
 namespace {
-
-double MsSince(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t)
-      .count();
-}
 
 // The timeline a stream integrates: the IMU's as configured, or with the
 // visual source camera-frame rates on the camera clock.

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <ceres/problem.h>
 
+#include "steadiface_core/common/stopwatch.h"
 #include "steadiface_core/stabilizer/stabilizer.h"
 
 namespace steadiface {
@@ -28,9 +29,7 @@ namespace stabilizer_internal {
 
 using Clock = std::chrono::steady_clock;
 
-inline double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using ::steadiface::MsSince;
 
 }  // namespace stabilizer_internal
 }  // namespace steadiface

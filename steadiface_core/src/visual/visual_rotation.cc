@@ -10,6 +10,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "steadiface_core/camera/lens_distortion.h"
+#include "steadiface_core/common/stopwatch.h"
 #include "visual/rotation_fit.h"
 
 namespace steadiface {
@@ -336,9 +337,7 @@ Status VisualRotationEstimator::Process(const cv::Mat& gray, Time stamp,
   Refill(small, mask);
   prev_ = small;
   prev_stamp_ = stamp;
-  out->ms = std::chrono::duration<double, std::milli>(
-                std::chrono::steady_clock::now() - t0)
-                .count();
+  out->ms = MsSince(t0);
   return Status::Ok();
 }
 

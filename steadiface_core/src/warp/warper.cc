@@ -8,18 +8,13 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/common/stopwatch.h"
 #include "steadiface_core/warp/mesh_sampler.h"
 #include "steadiface_core/warp/warp_geometry.h"
 #include "warp/mesh_scanline.h"
 
 namespace steadiface {
 namespace {
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(
-             std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 }  // namespace
 
