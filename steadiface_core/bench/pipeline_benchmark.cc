@@ -19,40 +19,16 @@
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/simulator.h"
+#include "walk_frames.h"
 
 namespace steadiface {
 namespace {
 
 constexpr int kFrames = 60;
 
-struct Sequence {
-  std::unique_ptr<sim::Simulator> sim;
-  std::vector<cv::Mat> frames;
-};
+using Sequence = bench::WalkFrames;
 
-const Sequence& Get(int w, int h) {
-  static std::vector<std::pair<std::pair<int, int>, Sequence>> cache;
-  for (auto& c : cache) {
-    if (c.first == std::make_pair(w, h)) return c.second;
-  }
-  Sequence s;
-  sim::SimulatorOptions o;
-  o.data_dir = STEADIFACE_TEST_DATA_DIR;
-  // Without the preset or the simulator, no frames: the benchmark skips.
-  const bool preset = sim::ApplyPreset("walk", &o).ok();
-  o.width = w;
-  o.height = h;
-  o.duration_s = (kFrames + 1) / o.fps;
-  if (preset && sim::Simulator::Create(o, &s.sim).ok()) {
-    sim::SimTruth truth;
-    for (int i = 0; i < s.sim->num_frames() && i < kFrames; ++i) {
-      cv::Mat f;
-      if (s.sim->Render(i, &f, &truth).ok()) s.frames.push_back(f);
-    }
-  }
-  cache.emplace_back(std::make_pair(w, h), std::move(s));
-  return cache.back().second;
-}
+const Sequence& Get(int w, int h) { return bench::GetWalkFrames(w, h, kFrames); }
 
 // The benchmark's options: the method's, with the warp threads, the warp
 // mode (0 global, 1 layered, 2 composite), the rotation source (1 visual)

@@ -16,6 +16,7 @@
 #include "steadiface_core/common/percentile.h"
 #include "steadiface_core/sim/simulator.h"
 #include "steadiface_core/visual/visual_rotation.h"
+#include "walk_frames.h"
 
 namespace steadiface {
 namespace {
@@ -23,7 +24,7 @@ namespace {
 constexpr int kFrames = 40;
 
 struct Frames {
-  std::unique_ptr<sim::Simulator> sim;
+  const sim::Simulator* sim = nullptr;
   std::vector<cv::Mat> grey;
   std::vector<cv::Rect2d> faces;
 };
@@ -33,25 +34,18 @@ const Frames& Get(int w, int h) {
   for (auto& c : cache) {
     if (c.first == std::make_pair(w, h)) return c.second;
   }
+  const bench::WalkFrames& walk = bench::GetWalkFrames(w, h, kFrames);
   Frames f;
-  sim::SimulatorOptions o;
-  o.data_dir = STEADIFACE_TEST_DATA_DIR;
-  const bool preset = sim::ApplyPreset("walk", &o).ok();
-  o.width = w;
-  o.height = h;
-  o.duration_s = (kFrames + 1) / o.fps;
-  if (preset && sim::Simulator::Create(o, &f.sim).ok()) {
-    for (int i = 0; i < kFrames; ++i) {
-      cv::Mat bgr, grey;
-      sim::SimTruth truth;
-      if (!f.sim->Render(i, &bgr, &truth).ok()) break;
-      cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-      f.grey.push_back(grey);
-      const double s = truth.face_scale_px;
-      f.faces.push_back(truth.head_in_view ? cv::Rect2d(truth.head_px.x() - 0.5 * s,
-                                                        truth.head_px.y() - 0.6 * s, s, 1.2 * s)
-                                           : cv::Rect2d());
-    }
+  f.sim = walk.sim.get();
+  for (size_t i = 0; i < walk.frames.size(); ++i) {
+    cv::Mat grey;
+    cv::cvtColor(walk.frames[i], grey, cv::COLOR_BGR2GRAY);
+    f.grey.push_back(grey);
+    const sim::SimTruth& truth = walk.truth[i];
+    const double s = truth.face_scale_px;
+    f.faces.push_back(truth.head_in_view ? cv::Rect2d(truth.head_px.x() - 0.5 * s,
+                                                      truth.head_px.y() - 0.6 * s, s, 1.2 * s)
+                                         : cv::Rect2d());
   }
   cache.emplace_back(std::make_pair(w, h), std::move(f));
   return cache.back().second;
