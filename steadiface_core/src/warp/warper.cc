@@ -14,9 +14,6 @@
 #include "warp/mesh_scanline.h"
 
 namespace steadiface {
-namespace {
-
-}  // namespace
 
 Status ParseWarpMode(const std::string& name, WarpMode* mode) {
   if (name == "global") {
