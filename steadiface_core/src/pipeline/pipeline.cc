@@ -253,11 +253,13 @@ const FaceObservation* Pipeline::FaceStep(const cv::Mat& image, Time stamp,
     }
     // A face error never stops stabilization: it is a frame without a face.
     // A followed head (turned past the landmarks) is held in global mode
-    // only: its landmarks are the last fit's shape moved with it, not its
-    // outline, and the layered and composite modes cut the subject region
-    // from them (their background is never moved by the face).
+    // and by the composite's subject layer (global mode's pose; its matte
+    // starts from the followed shape and finds the outline from motion,
+    // colour and the plate). Not in layered mode: its band is cut from the
+    // landmarks' outline, and the last fit's shape moved with the head is
+    // not that outline.
     const bool usable =
-        f->face.valid || (f->face.followed && options_.warp.mode == WarpMode::kGlobal);
+        f->face.valid || (f->face.followed && options_.warp.mode != WarpMode::kLayered);
     if (usable) {
       *observation = f->face.ToObservation();
       obs = observation;
