@@ -311,7 +311,9 @@ Status Pipeline::WarpStep(const cv::Mat& image, Time stamp, const FaceObservatio
     f.timings.mesh_ms = warper_->timings().mesh_ms;
     f.timings.maps_ms = warper_->timings().maps_ms;
     f.timings.remap_ms = warper_->timings().remap_ms;
-  } else if (defer_render_ || (f.withheld && options_.render_output)) {
+  } else if (defer_render_ || options_.render_output) {
+    // The mesh without the picture: drawn later (deferred), or never (a
+    // withheld frame, whose mesh is still the warp's state).
     s = warper_->ComputeMesh(f.stabilizer.R_v, f.stabilizer.t, f.stabilizer.rows);
     f.timings.mesh_ms = warper_->timings().mesh_ms;
   }
