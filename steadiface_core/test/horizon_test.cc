@@ -118,7 +118,7 @@ TEST(HorizonCostTest, IsTheSineOfTheRollTimesTheScale) {
     const Eigen::Quaterniond R_v = Roll(a);
     const double q[4] = {R_v.x(), R_v.y(), R_v.z(), R_v.w()};
     double r = NAN;
-    ASSERT_TRUE(HorizonCost(up_world, scale)(q, &r));
+    ASSERT_TRUE(HorizonCost(up_world, scale, 0.0)(q, &r));
     const double roll = HorizonRoll(R_v * up_world);
     EXPECT_NEAR(r, scale * std::sin(roll), 1e-12) << a;
     EXPECT_NEAR(std::abs(r), scale * std::abs(std::sin(a)), 1e-12) << a;
@@ -128,8 +128,32 @@ TEST(HorizonCostTest, IsTheSineOfTheRollTimesTheScale) {
       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()));
   const double q[4] = {up.x(), up.y(), up.z(), up.w()};
   double r = NAN;
-  ASSERT_TRUE(HorizonCost(up_world, scale)(q, &r));
+  ASSERT_TRUE(HorizonCost(up_world, scale, 0.0)(q, &r));
   EXPECT_EQ(r, 0.0);
+}
+
+// level's tolerance: a roll within phi_0 is left alone, and beyond it the
+// residual is the sine's excess, continuous at the edge.
+TEST(HorizonCostTest, LeavesARollWithinTheToleranceAlone) {
+  const Eigen::Vector3d up_world(0, -1, 0);
+  const double scale = 2.0, phi0 = 1.0 * M_PI / 180.0;
+  for (double a : {-0.5, 0.0, 0.3, 0.9, 1.0, 1.5, -2.0, 10.0}) {
+    const Eigen::Quaterniond R_v = Roll(a * M_PI / 180.0);
+    const double q[4] = {R_v.x(), R_v.y(), R_v.z(), R_v.w()};
+    double r = NAN;
+    ASSERT_TRUE(HorizonCost(up_world, scale, std::sin(phi0))(q, &r));
+    const double s = std::sin(HorizonRoll(R_v * up_world));
+    const double excess = std::max(0.0, std::abs(s) - std::sin(phi0));
+    EXPECT_NEAR(std::abs(r), scale * excess, 1e-12) << a;
+    if (excess > 0.0) EXPECT_EQ(r > 0.0, s > 0.0) << "pulls towards level: " << a;
+  }
+  // 1.5 deg with a 1 deg tolerance pulls as 0.5 deg would without one, to
+  // first order.
+  const Eigen::Quaterniond R_v = Roll(1.5 * M_PI / 180.0);
+  const double q[4] = {R_v.x(), R_v.y(), R_v.z(), R_v.w()};
+  double r = NAN;
+  ASSERT_TRUE(HorizonCost(up_world, scale, std::sin(phi0))(q, &r));
+  EXPECT_NEAR(std::abs(r), scale * 0.5 * M_PI / 180.0, 1e-5);
 }
 
 TEST(HorizonOptionsTest, AreChecked) {
@@ -139,6 +163,9 @@ TEST(HorizonOptionsTest, AreChecked) {
   EXPECT_FALSE(ValidateHorizonOptions(o).ok());
   o = HorizonOptions();
   o.lowpass_hz = NAN;
+  EXPECT_FALSE(ValidateHorizonOptions(o).ok());
+  o = HorizonOptions();
+  o.level_tolerance_deg = -0.5;
   EXPECT_FALSE(ValidateHorizonOptions(o).ok());
   HorizonMode m;
   EXPECT_TRUE(ParseHorizonMode("lock", &m).ok());

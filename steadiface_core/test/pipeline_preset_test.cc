@@ -416,9 +416,10 @@ TEST(PipelinePresetTest, TheOutputIntrinsicsFollowTheDynamicCrop) {
 namespace steadiface {
 namespace {
 
-eval::Score RunHorizon(const sim::Simulator& s, HorizonMode mode) {
+eval::Score RunHorizon(const sim::Simulator& s, HorizonMode mode, double level_tolerance_deg = 1.0) {
   PipelineOptions po = eval::OptionsFor(s, eval::Method::kGyroOnly);
   po.horizon.mode = mode;
+  po.horizon.level_tolerance_deg = level_tolerance_deg;
   std::unique_ptr<eval::Scorecard> card;
   EXPECT_TRUE(eval::MakeScorecard(s, po, &card).ok());
   const Status st = eval::RunMethod(s, eval::Method::kGyroOnly, po, false, card.get(), nullptr);
@@ -448,6 +449,27 @@ TEST(PipelinePresetTest, TheHorizonIsHeldLevelFromTheAccelerometer) {
   EXPECT_LE(lock.output_roll_rms_deg, 0.5);
   EXPECT_EQ(lock.undefined_fraction, 0.0);
   EXPECT_LE(walk_level.visible_background_jitter_px, 1.1 * walk_off.visible_background_jitter_px);
+}
+
+// A nearly still camera: the gravity estimate's own error in its first
+// seconds (a few tenths of a degree, from the hand's accelerations) is
+// within level's 1 deg tolerance, so level leaves the view's roll as off
+// does. Pulling every roll (tolerance 0) rolls the view after that error:
+// 0.04 -> 0.06 deg RMS, its visible background 1.2x as jittery (seed 1).
+TEST(PipelinePresetTest, LevelLeavesANearlyStillViewsRollAlone) {
+  auto drift = MakeSimulator("drift");
+  const eval::Score off = RunHorizon(*drift, HorizonMode::kOff);
+  const eval::Score level = RunHorizon(*drift, HorizonMode::kLevel);
+  const eval::Score pull_all = RunHorizon(*drift, HorizonMode::kLevel, 0.0);
+  std::cout << "[ horizon, gyro-only ] drift: output roll RMS off " << off.output_roll_rms_deg
+            << " / level " << level.output_roll_rms_deg << " / level without tolerance "
+            << pull_all.output_roll_rms_deg << " deg; visible background "
+            << off.visible_background_jitter_px << " / " << level.visible_background_jitter_px
+            << " / " << pull_all.visible_background_jitter_px << " px\n";
+  EXPECT_LE(level.output_roll_rms_deg, off.output_roll_rms_deg + 0.005);
+  EXPECT_LE(level.visible_background_jitter_px, 1.02 * off.visible_background_jitter_px);
+  EXPECT_GT(pull_all.output_roll_rms_deg, off.output_roll_rms_deg + 0.01);
+  EXPECT_GT(pull_all.visible_background_jitter_px, 1.1 * off.visible_background_jitter_px);
 }
 
 }  // namespace

@@ -61,7 +61,8 @@ const char kUsage[] =
     "       [--crop-mode fixed|dynamic] (output.crop: the fixed crop ratio, or the\n"
     "         dynamic crop between --widest R and it; default: the package's)\n"
     "       [--horizon off|level|lock] (output.horizon: the roll against the\n"
-    "         accelerometer's gravity)\n"
+    "         accelerometer's gravity) [--level-tolerance DEG] (horizon.level_tolerance:\n"
+    "         level leaves a roll within DEG alone; 0 pulls every roll)\n"
     "       [--rotation-source auto|imu|visual] (visual: the camera's rotation\n"
     "         from the video, the IMU unused; auto, the default: the video for\n"
     "         the frames the gyro does not cover)\n"
@@ -167,6 +168,7 @@ void AddViewFlags(CommandLine* cl, steadiface::eval::ViewOverrides* v) {
     return steadiface::ParseHorizonMode(s, &m).ok();
   });
   cl->Double("--level-weight", &v->level_weight).Double("--lock-weight", &v->lock_weight);
+  cl->Double("--level-tolerance", &v->level_tolerance_deg);
   cl->Double("--gravity-warmup", &v->gravity_warmup_s).Double("--gravity-tau", &v->gravity_tau_s);
   cl->Double("--widest", &v->widest).Flag("--start-tight", &v->start_tight);
   cl->Double("--shake-hz", &v->shake_hz).Double("--headroom", &v->headroom);

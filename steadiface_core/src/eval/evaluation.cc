@@ -331,6 +331,7 @@ Status ApplyViewOverrides(const ViewOverrides& v, PipelineOptions* po) {
   set(v.widest, &po->crop.widest_crop_ratio);
   set(v.level_weight, &po->horizon.level_weight);
   set(v.lock_weight, &po->horizon.lock_weight);
+  set(v.level_tolerance_deg, &po->horizon.level_tolerance_deg);
   set(v.gravity_warmup_s, &po->horizon.warmup_s);
   set(v.gravity_tau_s, &po->horizon.time_constant_s);
   set(v.shake_hz, &po->crop.shake_path_hz);

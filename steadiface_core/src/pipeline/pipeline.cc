@@ -390,8 +390,10 @@ void Pipeline::HorizonStep(PipelineFrame* f) {
     } else {
       target.active = true;
       target.up_world = gravity_.up_world();
-      target.weight = o.mode == HorizonMode::kLock ? o.lock_weight : o.level_weight;
-      target.level_reference = o.mode == HorizonMode::kLock;
+      const bool lock = o.mode == HorizonMode::kLock;
+      target.weight = lock ? o.lock_weight : o.level_weight;
+      target.tolerance_rad = lock ? 0.0 : o.level_tolerance_deg * M_PI / 180.0;
+      target.level_reference = lock;
     }
   }
   h.active = target.active;

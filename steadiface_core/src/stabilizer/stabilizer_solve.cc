@@ -91,7 +91,9 @@ void Stabilizer::AddRotationTerms(Time stamp, const OrientationTimeline& timelin
   const Eigen::Quaterniond R_ref = HorizonReference(f->R_r);
   if (horizon_.active && horizon_.weight > 0.0) {
     pp->b_horizon.push_back(problem.AddResidualBlock(
-        HorizonCost::Create(horizon_.up_world, std::sqrt(horizon_.weight)), nullptr,
+        HorizonCost::Create(horizon_.up_world, std::sqrt(horizon_.weight),
+                            std::sin(horizon_.tolerance_rad)),
+        nullptr,
         pp->q_block));
   }
   if (w.distortion > 0.0) {

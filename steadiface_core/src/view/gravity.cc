@@ -47,6 +47,8 @@ Status ValidateHorizonOptions(const HorizonOptions& o) {
     err << "horizon.lowpass must be in [0.01, 10] Hz, got " << o.lowpass_hz;
   } else if (!in(o.warmup_s, 0.0, 60.0)) {
     err << "horizon.warmup must be in [0, 60] s, got " << o.warmup_s;
+  } else if (!in(o.level_tolerance_deg, 0.0, 10.0)) {
+    err << "horizon.level_tolerance must be in [0, 10] deg, got " << o.level_tolerance_deg;
   } else if (!in(o.level_weight, 0.0, 1e6) || !in(o.lock_weight, 0.0, 1e6)) {
     err << "horizon.level_weight and lock_weight must be in [0, 1e6], got "
         << o.level_weight << " and " << o.lock_weight;

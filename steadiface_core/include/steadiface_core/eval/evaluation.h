@@ -23,6 +23,8 @@ struct ViewOverrides {
   std::string horizon;
   /// horizon.level_weight, horizon.lock_weight [-].
   double level_weight = NAN, lock_weight = NAN;
+  /// horizon.level_tolerance [deg].
+  double level_tolerance_deg = NAN;
   /// horizon.warmup, horizon.time_constant [s].
   double gravity_warmup_s = NAN, gravity_tau_s = NAN;
   /// output.dynamic.widest_crop_ratio [-].

@@ -127,6 +127,9 @@ struct HorizonTarget {
   bool active = false;
   Eigen::Vector3d up_world = Eigen::Vector3d(0.0, -1.0, 0.0);
   double weight = 0.0;
+  /// E_h leaves a roll within this alone (level's tolerance; 0 for lock)
+  /// [rad].
+  double tolerance_rad = 0.0;
   bool level_reference = false;
 };
 

@@ -58,6 +58,13 @@ struct HorizonOptions {
   /// the real camera turned level, which leaves the face its term.
   double level_weight = 4.0;
   double lock_weight = 50.0;
+  /// `level` leaves a roll within this of the estimated horizon alone [deg]:
+  /// the estimate's own error on a hand-held or a legged robot's camera, a
+  /// mean of readings the hand's and the gait's accelerations disturb, is
+  /// up to about 0.7 deg in its first seconds (docs/evaluation.md, "The
+  /// level horizon's tolerance"), and pulling within it would roll a
+  /// nearly still view after that error. `lock` holds 0. In [0, 10].
+  double level_tolerance_deg = 1.0;
 };
 
 Status ValidateHorizonOptions(const HorizonOptions& options);
