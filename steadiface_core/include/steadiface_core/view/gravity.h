@@ -51,8 +51,9 @@ struct HorizonOptions {
   /// number at least 10): their mean by then is steady enough not to roll
   /// the output as it settles. In [0, 60].
   double warmup_s = 0.3;
-  /// Weights of the horizon term E_h (the roll against gravity, squared
-  /// sine) in the solve: `level` and `lock` [-]. Both below the face term's
+  /// Weights of the horizon term E_h (the sine of the roll against
+  /// gravity beyond level_tolerance_deg, squared; HorizonCost) in the
+  /// solve: `level` and `lock` [-]. Both below the face term's
   /// w_f (stabilizer weights.fit, 100), so where the two conflict the face
   /// wins; `lock` holds the roll mostly by measuring E_d and E_o against
   /// the real camera turned level, which leaves the face its term.
