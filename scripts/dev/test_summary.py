@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Counts test cases in JUnit XML files (gtest, rostest, catkin) and prints
-one closing line: `N passed, N failed[, N skipped]`. Exits 1 on any failure
-or when no test ran at all, so an empty run can never look green.
+one line per failure, with the start of its message (a CI log may show only
+its tail), then one closing line: `N passed, N failed[, N skipped]`. Exits 1
+on any failure or when no test ran at all, so an empty run can never look
+green.
 
 usage: test_summary.py RESULTS_DIR [--expect-files N]
 """
@@ -31,9 +33,14 @@ def main():
         for case in cases:
             n_cases += 1
             name = "%s.%s" % (case.get("classname", "?"), case.get("name", "?"))
-            if case.find("failure") is not None or case.find("error") is not None:
+            bad = case.find("failure")
+            if bad is None:
+                bad = case.find("error")
+            if bad is not None:
                 failed += 1
-                failures.append("%s: %s" % (os.path.basename(path), name))
+                why = " ".join((bad.get("message") or bad.text or "").split())
+                failures.append("%s: %s%s" % (os.path.basename(path), name,
+                                              (" -- " + why[:400]) if why else ""))
             elif case.find("skipped") is not None or case.get("status") == "notrun":
                 skipped += 1
             else:
