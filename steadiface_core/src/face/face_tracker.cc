@@ -76,6 +76,7 @@ void FaceTracker::Reset() {
   fitted_last_frame_ = false;
   have_fitted_pose_ = false;
   recent_abs_yaw_ = 0.0;
+  fitted_appearance_ = 1.0;
   have_last_rotation_ = false;
   frames_since_detect_ = 0;
   frames_tracked_ = 0;
@@ -145,6 +146,8 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
   recent_abs_yaw_ = std::max(posed ? std::abs(info->yaw) : 0.0,
                              recent_abs_yaw_ - kTurnMemoryRadPerS * std::min(dt, 10.0));
   have_fitted_pose_ = posed;
+  // Without a patch (external landmarks) the appearance was not measured.
+  fitted_appearance_ = patch.empty() ? 1.0 : info->appearance;
   fitted_yaw_ = info->yaw;
   fitted_pitch_ = info->pitch;
   fitted_roll_ = info->roll;
@@ -425,11 +428,15 @@ bool FaceTracker::StartFollow(Time stamp, double scale) {
   // visible parts of its region still move with the head, and it is
   // followed by their translation, briefly, while they continue the head's
   // own motion (Follow's gate), so the tracker never follows the cover.
+  // A cover starts in one region of a face that still looks like itself;
+  // a face whose whole appearance had faded by its last fit is whipping
+  // round faster than PnP's yaw shows, and is held.
   const double since_fit = ToSeconds(stamp - last_seen_);
   const bool turned = options_.follow_turned_s > 0.0 && have_fitted_pose_ && !past_profile_ &&
                       recent_abs_yaw_ >= options_.follow_min_yaw_rad &&
                       since_fit <= options_.follow_turned_s;
   const bool covered = options_.follow_covered_s > 0.0 && have_own_shift_ &&
+                       fitted_appearance_ >= options_.follow_covered_min_appearance &&
                        (!have_fitted_pose_ || recent_abs_yaw_ < options_.follow_min_yaw_rad) &&
                        since_fit <= options_.follow_covered_s;
   if (following_) {

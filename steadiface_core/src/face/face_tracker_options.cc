@@ -44,6 +44,9 @@ Status ValidateFaceTrackerOptions(const FaceTrackerOptions& o) {
     err << "face.follow_turned must be in [0, 60] s, got " << o.follow_turned_s;
   } else if (!(o.follow_covered_s >= 0.0 && o.follow_covered_s <= 10.0)) {
     err << "face.follow_covered must be in [0, 10] s, got " << o.follow_covered_s;
+  } else if (!(o.follow_covered_min_appearance >= 0.0 && o.follow_covered_min_appearance <= 1.0)) {
+    err << "face.follow_covered_min_appearance must be in [0, 1], got "
+        << o.follow_covered_min_appearance;
   } else if (!(o.follow_speed_change_noise >= 0.0 && o.follow_speed_change_noise <= 100.0)) {
     err << "face.follow_speed_change_noise must be in [0, 100], got "
         << o.follow_speed_change_noise;

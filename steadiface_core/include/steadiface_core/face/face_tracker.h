@@ -97,6 +97,15 @@ struct FaceTrackerOptions {
   /// cover's, so the face is then held. 0 = off: held from the first
   /// failed frame [s].
   double follow_covered_s = 0.5;
+  /// ... only when the last fit's whole-face appearance (the aligned
+  /// patch's correlation with the locked face's) was at least this. A
+  /// cover starts in one region of a face that still looks like itself; a
+  /// head whipping round fades the whole face over its last fits and is
+  /// lost near min_appearance, before PnP's yaw reaches follow_min_yaw_rad.
+  /// Followed by its translation, that turn's swing was held as the
+  /// head's motion; it is held instead. 0 = every face lost while facing
+  /// the camera is followed [-].
+  double follow_covered_min_appearance = 0.6;
   /// ... and every followed frame, covered or turned, must move on with
   /// the head's own motion of the frame before within this many face
   /// scales (RMS landmark radius) per frame, and at least 2 px; else the
@@ -262,7 +271,8 @@ class FaceTracker {
   double fitted_yaw_ = 0.0, fitted_pitch_ = 0.0, fitted_roll_ = 0.0;  // [rad]
   double fitted_yaw_rate_ = 0.0;                 // over consecutive fits [rad/frame]
   bool fitted_last_frame_ = false;
-  double recent_abs_yaw_ = 0.0;                  // the turn lately, for Follow [rad]
+  double recent_abs_yaw_ = 0.0;
+  double fitted_appearance_ = 1.0;  // the last fit's whole-face appearance [-]                  // the turn lately, for Follow [rad]
   Time last_located_;                            // last fitted or followed
   Time last_frame_;                              // the previous frame's stamp
   bool have_last_frame_ = false;
