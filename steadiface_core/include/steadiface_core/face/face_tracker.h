@@ -271,8 +271,8 @@ class FaceTracker {
   double fitted_yaw_ = 0.0, fitted_pitch_ = 0.0, fitted_roll_ = 0.0;  // [rad]
   double fitted_yaw_rate_ = 0.0;                 // over consecutive fits [rad/frame]
   bool fitted_last_frame_ = false;
-  double recent_abs_yaw_ = 0.0;
-  double fitted_appearance_ = 1.0;  // the last fit's whole-face appearance [-]                  // the turn lately, for Follow [rad]
+  double recent_abs_yaw_ = 0.0;                  // the turn lately, for Follow [rad]
+  double fitted_appearance_ = 1.0;               // the last fit's whole-face appearance [-]
   Time last_located_;                            // last fitted or followed
   Time last_frame_;                              // the previous frame's stamp
   bool have_last_frame_ = false;
