@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <ceres/autodiff_cost_function.h>
@@ -21,6 +22,7 @@
 #include "steadiface_core/stabilizer/head_smoother.h"
 #include "steadiface_core/stabilizer/protrusion_cost.h"
 #include "steadiface_core/stabilizer/rotation_smoothness_cost.h"
+#include "steadiface_core/stabilizer/stabilizer_options.h"
 #include "steadiface_core/stabilizer/stall_tolerant_solve.h"
 #include "steadiface_core/stabilizer/translation_smoothness_cost.h"
 #include "test_util.h"
@@ -235,6 +237,28 @@ TEST(CostTermsTest, ProtrusionIsZeroInsideTheMarginAndPositiveOutside) {
   double q[4] = {Rv.x(), Rv.y(), Rv.z(), Rv.w()}, tt[2] = {0.003, 0.0017};
   CheckGradient(ProtrusionCost::Create(&geo, rows, 3.0, 0.002, 1.0), {&qm, nullptr},
                 {q, tt});
+}
+
+// E_p's tolerance follows the fitting weight: the stiff no-face wall at
+// w_f 0, the face's at the nominal w_f and above, linear between.
+TEST(CostTermsTest, ProtrusionToleranceFollowsTheFittingWeight) {
+  TermOptions t;
+  t.protrusion_alpha = 0.002;
+  t.protrusion_alpha_face = 0.02;
+  EXPECT_DOUBLE_EQ(ProtrusionAlpha(t, 0.0, 100.0), 0.002);
+  EXPECT_DOUBLE_EQ(ProtrusionAlpha(t, 25.0, 100.0), 0.0065);
+  EXPECT_DOUBLE_EQ(ProtrusionAlpha(t, 100.0, 100.0), 0.02);
+  EXPECT_DOUBLE_EQ(ProtrusionAlpha(t, 400.0, 100.0), 0.02);
+  // No fitting term or no usable weight: the no-face wall.
+  EXPECT_DOUBLE_EQ(ProtrusionAlpha(t, 50.0, 0.0), 0.002);
+  EXPECT_DOUBLE_EQ(ProtrusionAlpha(t, std::nan(""), 100.0), 0.002);
+  // Out of range is refused.
+  StabilizerOptions o;
+  EXPECT_TRUE(ValidateStabilizerOptions(o).ok());
+  o.terms.protrusion_alpha_face = 0.0;
+  const Status bad = ValidateStabilizerOptions(o);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("protrusion_alpha_face"), std::string::npos) << bad.message();
 }
 
 // ---------- Head smoother ----------

@@ -74,6 +74,8 @@ const char kUsage[] =
     "         subject_reach_hold: H follows the slow part of that position)\n"
     "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
     "         head target's smoothing, Eq. 1)\n"
+    "       [--protrusion-alpha-face A] (terms.protrusion_alpha_face: E_p's\n"
+    "         tolerance while a face is fitted; 0.002 is the stiff no-face wall)\n"
     "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
     "         per frame, the crop-window shifts the margin allows, rolling shutter\n"
     "         included, in 72 directions [input px], for scripts/analysis/crop_bound.py)\n"
@@ -130,6 +132,7 @@ void AddPipelineFlags(CommandLine* cl, EvaluationOptions* o) {
   });
   cl->Double("--pivot-depth", &o->pose_pivot_depth);
   cl->Double("--head-w-stay", &o->head_w_stay).Double("--head-d-ref", &o->head_d_ref);
+  cl->Double("--protrusion-alpha-face", &o->protrusion_alpha_face);
   cl->Double("--subject-reach", &o->subject_reach).Double("--reach-lowpass", &o->reach_lowpass_hz);
   cl->Double("--reach-hold", &o->reach_hold);
   steadiface::LayerBlendOptions* b = &o->blend;

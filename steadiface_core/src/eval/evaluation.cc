@@ -112,6 +112,9 @@ Status PipelineOptionsFor(const EvaluationOptions& o, const sim::Simulator& sim,
   po.rotation_source = o.rotation_source;
   if (std::isfinite(o.head_w_stay)) po.stabilizer.head.w_stay = o.head_w_stay;
   if (std::isfinite(o.head_d_ref)) po.stabilizer.head.d_ref = o.head_d_ref;
+  if (std::isfinite(o.protrusion_alpha_face)) {
+    po.stabilizer.terms.protrusion_alpha_face = o.protrusion_alpha_face;
+  }
   if (std::isfinite(o.pose_pivot_depth)) {
     po.stabilizer.dynamic.pose_pivot_depth = o.pose_pivot_depth;
   }

@@ -1,5 +1,6 @@
 #include "steadiface_core/stabilizer/stabilizer_options.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -24,6 +25,13 @@ Status First(std::initializer_list<std::string> checks) {
 
 }  // namespace
 
+double ProtrusionAlpha(const TermOptions& terms, double fit_weight, double nominal_fit) {
+  const double share = nominal_fit > 0.0 && std::isfinite(fit_weight)
+                           ? std::min(std::max(fit_weight / nominal_fit, 0.0), 1.0)
+                           : 0.0;
+  return terms.protrusion_alpha + share * (terms.protrusion_alpha_face - terms.protrusion_alpha);
+}
+
 Status ValidateStabilizerWeights(const StabilizerWeights& w) {
   return First({Range("weights.fit", w.fit, 0, 1e6),
                 Range("weights.distortion", w.distortion, 0, 1e6),
@@ -46,6 +54,7 @@ Status ValidateStabilizerOptions(const StabilizerOptions& o) {
       Range("terms.distortion_threshold", t.distortion_threshold_rad, 0, 1.5),
       Range("terms.distortion_slope", t.distortion_slope, 1, 1e4),
       Range("terms.protrusion_alpha", t.protrusion_alpha, 1e-5, 1.0),
+      Range("terms.protrusion_alpha_face", t.protrusion_alpha_face, 1e-5, 1.0),
       Range("terms.protrusion_shrink", t.protrusion_shrink, 0, 0.2),
       Range("terms.protrusion_samples_per_edge", t.protrusion_samples_per_edge,
             2, 256),

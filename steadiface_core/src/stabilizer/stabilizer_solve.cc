@@ -153,7 +153,8 @@ void Stabilizer::AddOffsetTerms(const LayerState& layer, const StabilizerWeights
     for (double y : at_init.rows) R_samples.push_back(f->rows.At(y));
     pp->b_prot.push_back(problem.AddResidualBlock(
         ProtrusionCost::Create(&protrusion_, std::move(R_samples), shrink_px,
-                               options_.terms.protrusion_alpha, w.protrusion),
+                               ProtrusionAlpha(options_.terms, w.fit, options_.weights.fit),
+                               w.protrusion),
         nullptr, pp->q_block, pp->t_block));
   }
 

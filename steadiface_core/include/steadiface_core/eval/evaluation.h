@@ -89,6 +89,9 @@ struct EvaluationOptions {
   Eigen::Vector2d window_s = Eigen::Vector2d::Constant(NAN);
   /// head.w_stay [-] and head.d_ref [fraction of the width].
   double head_w_stay = NAN, head_d_ref = NAN;
+  /// terms.protrusion_alpha_face: E_p's tolerance while a face is fitted
+  /// [fraction of the width].
+  double protrusion_alpha_face = NAN;
   /// dynamic.pose_pivot_depth: the pose-invariant head centre [face scales].
   double pose_pivot_depth = NAN;
   /// stabilizer.subject_reach [jaw widths] (0: off), its low-pass [Hz] and hold.

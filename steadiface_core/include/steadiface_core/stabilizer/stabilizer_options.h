@@ -37,14 +37,27 @@ struct TermOptions {
   double distortion_threshold_rad = 0.15;
   /// E_d: logistic slope [1/rad].
   double distortion_slope = 150.0;
-  /// E_p: α, the tolerated protrusion [normalized units, fraction of width].
+  /// E_p: α, the tolerated protrusion [normalized units, fraction of width],
+  /// where no face is fitted (w_f 0: gyro-only poses, the layered
+  /// background layer).
   double protrusion_alpha = 0.002;
+  /// E_p: α while E_f holds a face at its full weight [fraction of width];
+  /// between the two in proportion to w_f / weights.fit (ProtrusionAlpha).
+  /// Against the stiff fit term a wall as stiff as protrusion_alpha stops
+  /// the solve short of both: at a 0.85 crop on `vlog` one frame's face
+  /// was held 12 px off its target with E_p at 0.
+  double protrusion_alpha_face = 0.02;
   /// E_p: the real boundary is shrunk by this on every side before measuring
   /// protrusion [fraction of width].
   double protrusion_shrink = 0.005;
   /// E_p: boundary samples per output edge [count].
   int protrusion_samples_per_edge = 8;
 };
+
+/// E_p's α for a frame whose fitting weight is `fit_weight` out of the
+/// nominal `nominal_fit` (weights.fit): protrusion_alpha at 0, rising
+/// linearly to protrusion_alpha_face at the nominal weight and above.
+double ProtrusionAlpha(const TermOptions& terms, double fit_weight, double nominal_fit);
 
 /// Dynamic weight adjustment (paper §4.4). Every factor moves towards its
 /// target with the time constant `fade_time_s`, so weights never jump.
