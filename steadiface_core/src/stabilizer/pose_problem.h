@@ -21,6 +21,7 @@ struct Stabilizer::PoseProblem {
   ceres::Problem problem;
   std::vector<ceres::ResidualBlockId> b_fit, b_dist, b_follow, b_rot, b_trans, b_prot,
       b_horizon;
+  double protrusion_alpha = 0.0;  ///< E_p's tolerance this solve used
   Eigen::Map<Eigen::Vector4d> q() { return Eigen::Map<Eigen::Vector4d>(q_block); }
   Eigen::Map<Eigen::Vector2d> t() { return Eigen::Map<Eigen::Vector2d>(t_block); }
 };

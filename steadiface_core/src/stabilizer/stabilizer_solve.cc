@@ -151,10 +151,13 @@ void Stabilizer::AddOffsetTerms(const LayerState& layer, const StabilizerWeights
     std::vector<Eigen::Quaterniond> R_samples;
     R_samples.reserve(at_init.rows.size());
     for (double y : at_init.rows) R_samples.push_back(f->rows.At(y));
+    // The face's tolerance only where E_f holds a face this solve (AddFitTerms
+    // ran first): w_f alone stays above 0 while it fades after a loss.
+    const double fitted = pp->b_fit.empty() ? 0.0 : w.fit;
+    pp->protrusion_alpha = ProtrusionAlpha(options_.terms, fitted, options_.weights.fit);
     pp->b_prot.push_back(problem.AddResidualBlock(
         ProtrusionCost::Create(&protrusion_, std::move(R_samples), shrink_px,
-                               ProtrusionAlpha(options_.terms, w.fit, options_.weights.fit),
-                               w.protrusion),
+                               pp->protrusion_alpha, w.protrusion),
         nullptr, pp->q_block, pp->t_block));
   }
 
@@ -187,6 +190,7 @@ void Stabilizer::RunSolve(const Eigen::Quaterniond& R_v0, const Eigen::Vector2d&
     ++stats->solver_restarts;
   }
   f->solver.ran = true;
+  f->solver.protrusion_alpha = pp->protrusion_alpha;
   f->solver.iterations = static_cast<int>(summary.iterations.size()) - 1;
   f->solver.termination = ceres::TerminationTypeToString(summary.termination_type);
   f->solver.initial_cost = summary.initial_cost;

@@ -50,6 +50,10 @@ struct SolverReport {
   /// The wall-time cap ran out before the first step (a stall) and the
   /// solve was run again under the iteration cap alone.
   bool restarted = false;
+  /// E_p's tolerance α this solve used (fraction of the width): the face's
+  /// (terms.protrusion_alpha_face) only in proportion to a w_f that E_f
+  /// actually fitted, the paper's stiff wall otherwise. 0 when E_p was off.
+  double protrusion_alpha = 0.0;
 };
 
 /// Why the pose is what it is.

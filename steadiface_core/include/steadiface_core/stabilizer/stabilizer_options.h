@@ -38,8 +38,8 @@ struct TermOptions {
   /// E_d: logistic slope [1/rad].
   double distortion_slope = 150.0;
   /// E_p: α, the tolerated protrusion [normalized units, fraction of width],
-  /// where no face is fitted (w_f 0: gyro-only poses, the layered
-  /// background layer).
+  /// where no face is fitted (gyro-only poses, the layered background
+  /// layer, and a lost face's w_f fading out after its held face is let go).
   double protrusion_alpha = 0.002;
   /// E_p: α while E_f holds a face at its full weight [fraction of width];
   /// between the two in proportion to w_f / weights.fit (ProtrusionAlpha).
