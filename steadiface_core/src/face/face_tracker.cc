@@ -32,6 +32,9 @@ constexpr double kCoveredRegionUp = 0.4;
 // of the face in view, and its tracks agree within 0.1 px on the
 // simulator's hand (face_tracker_test) [-].
 constexpr int kCoveredMinInliers = 6;
+// The gain of the first-order filter on PnP's yaw change between
+// consecutive fits: the rate a follow starts from [-].
+constexpr double kFittedYawRateGain = 0.7;
 }  // namespace
 
 Status FaceTracker::Create(const CameraModel& model,
@@ -134,11 +137,10 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
     info->timings.pose_ms = MsSince(t0);
   }
   const bool posed = info->has_pose && std::isfinite(info->yaw);
-  // The turn's rate over consecutive fits, for a turn followed on
-  // (face/head_turn.h filters it the same way).
+  // The turn's rate over consecutive fits, for a turn followed on.
   const bool consecutive = posed && have_fitted_pose_ && !acquiring && after_fit;
   fitted_yaw_rate_ =
-      consecutive ? fitted_yaw_rate_ + kHeadTurnRateGain * (info->yaw - fitted_yaw_ - fitted_yaw_rate_)
+      consecutive ? fitted_yaw_rate_ + kFittedYawRateGain * (info->yaw - fitted_yaw_ - fitted_yaw_rate_)
                   : 0.0;
   // How far the face turned lately: the largest fitted |yaw|, forgotten at
   // kTurnMemoryRadPerS (PnP's yaw is noisy frame to frame).
@@ -449,7 +451,10 @@ bool FaceTracker::StartFollow(Time stamp, double scale) {
     head_turn_ = HeadTurn();
     head_turn_.radius_px = depth * scale;
     head_turn_.yaw = depth > 0.0 ? fitted_yaw_ : 0.0;
-    head_turn_.yaw_rate = depth > 0.0 ? fitted_yaw_rate_ : 0.0;
+    // PnP's rate, within what one frame's turn may be (HeadTurn).
+    head_turn_.yaw_rate =
+        depth > 0.0 ? std::max(-kHeadTurnMaxRate, std::min(kHeadTurnMaxRate, fitted_yaw_rate_))
+                    : 0.0;
     head_turn_.axis_px =
         Mean(last_landmarks_) + Eigen::Vector2d(head_turn_.radius_px * std::sin(head_turn_.yaw), 0);
     return true;

@@ -44,14 +44,23 @@ bool UpdateHeadTurn(const RegionFlow& flow, HeadTurn* head) {
   }
   var /= n;
   cov /= n;
-  // dx = d_axis - z d_yaw; the depths must spread by a twentieth of the radius.
-  // The rate follows one frame's measured turn through a first-order filter
-  // (kHeadTurnRateGain); unobservable, it decays.
-  if (var > (0.05 * r) * (0.05 * r)) {
-    const double measured = std::max(-0.15, std::min(0.15, -cov / var));
-    head->yaw_rate += kHeadTurnRateGain * (measured - head->yaw_rate);
-  } else {
-    head->yaw_rate *= 1.0 - kHeadTurnRateGain;
+  // dx = d_axis - z d_yaw. The rate is predicted unchanged, its variance
+  // grown; the depths must spread by a twentieth of the radius for a
+  // measurement, which enters by its standard error.
+  head->yaw_rate_var += kHeadTurnRateProcessSd * kHeadTurnRateProcessSd;
+  if (var > (0.05 * r) * (0.05 * r) && n > 3) {
+    const double slope = cov / var;
+    double residual = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      const double e = (dx[i] - dx_mean) - slope * (z[i] - z_mean);
+      residual += e * e;
+    }
+    residual = std::max(residual / (n - 2), kHeadTurnFlowSdFloor * kHeadTurnFlowSdFloor);
+    const double measured = std::max(-kHeadTurnMaxRate, std::min(kHeadTurnMaxRate, -slope));
+    const double measured_var = residual / (n * var);
+    const double gain = head->yaw_rate_var / (head->yaw_rate_var + measured_var);
+    head->yaw_rate += gain * (measured - head->yaw_rate);
+    head->yaw_rate_var *= 1.0 - gain;
   }
   const double d_yaw = head->yaw_rate;
   const double d_axis = dx_mean + d_yaw * z_mean;

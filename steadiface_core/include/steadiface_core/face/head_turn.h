@@ -6,15 +6,28 @@
 
 namespace steadiface {
 
-/// The gain of the first-order filter on the yaw's rate per frame. The
-/// flow is taken beyond the camera's rotation (the gyro, each row at its
-/// time), so one frame's measured turn is nearly clean; a light filter
-/// still steadies it on real footage. The rate's lag after a reversal by D
-/// leaves the yaw behind by D (1 - gain) / gain, and a wrong axis feeds
-/// back through the tracks' depths, so the gain is high: on turn_away
-/// (seeds 1-3) 0.35 / 0.5 / 0.7 / 1.0 give the head 5.2-6.3 / 4.8-5.7 /
-/// 4.6-5.6 / 4.6-5.6 px [-].
-constexpr double kHeadTurnRateGain = 0.7;
+/// The yaw's rate per frame is filtered as a constant rate (Kalman, one
+/// state): each frame's measured turn enters with its own standard error,
+/// from the fit's residuals and the spread of the tracks' depths. One
+/// frame's flow pins the turn only when the depths spread: over a face
+/// seen nearly frontally a 0.035 rad turn moves the tracks relative to one
+/// another by about 0.4 px, near their noise. A fixed gain took such frames
+/// at face value, and a frame with no spread of depths (or a wrong turn)
+/// handed the whole turning flow to the axis: turned 3.6 rad at 3x the
+/// preset's head motion, turn_away's axis slid 90 px off the head in ten
+/// frames. The rate's standard deviation may change by this much per
+/// frame (a head's turn speeding up or slowing down) [rad/frame].
+constexpr double kHeadTurnRateProcessSd = 0.01;
+/// The largest turn per frame a head is taken to make: one frame's
+/// measured turn and a follow's starting rate are clipped to it [rad/frame].
+constexpr double kHeadTurnMaxRate = 0.15;
+/// ... and starts at this when a follow takes the rate of the last fits
+/// (PnP's, filtered) [rad/frame].
+constexpr double kHeadTurnRateStartSd = 0.06;
+/// A track's flow is taken as no more precise than this, whatever the
+/// residuals of one frame's fit (a cylinder's flow fits exactly only in
+/// the simulator) [px].
+constexpr double kHeadTurnFlowSdFloor = 0.3;
 
 /// The largest |yaw| the cylinder follows [rad]. A head turned further
 /// shows the far side of its skull, and the flow no longer tells the turn
@@ -40,6 +53,8 @@ struct HeadTurn {
   double yaw = 0.0;
   /// The yaw's change per frame, filtered [rad/frame].
   double yaw_rate = 0.0;
+  /// The filtered rate's variance [(rad/frame)^2].
+  double yaw_rate_var = kHeadTurnRateStartSd * kHeadTurnRateStartSd;
   /// The face's distance from the axis in the image [px].
   double radius_px = 0.0;
   /// The yaw reached kHeadTurnMaxYaw: the head is past what the cylinder
@@ -52,12 +67,13 @@ struct HeadTurn {
 
 /// One frame: the axis moves by the flow's part common to all depths and
 /// the yaw by its part proportional to depth (least squares over the
-/// tracks). When the tracks' depths do not spread (they all face the
-/// camera, or all sit at the silhouette) the turn is not observable and
-/// only the translation is taken. The yaw stays within +-kHeadTurnMaxYaw
-/// (past_profile once it reaches it) and
-/// changes at most 0.15 rad per frame; its rate is filtered (kHeadTurnRateGain). False (state kept) with fewer than 3
-/// tracks or a radius <= 0.
+/// tracks). The measured turn updates the filtered rate by its standard
+/// error (kHeadTurnRateProcessSd above); when the tracks' depths do not
+/// spread (they all face the camera, or all sit at the silhouette) the turn
+/// is not observable and the rate is kept. The axis then moves by the flow
+/// beyond that turn. The yaw stays within +-kHeadTurnMaxYaw (past_profile
+/// once it reaches it) and changes at most kHeadTurnMaxRate per frame. False
+/// (state kept) with fewer than 3 tracks or a radius <= 0.
 bool UpdateHeadTurn(const RegionFlow& flow, HeadTurn* head);
 
 }  // namespace steadiface
