@@ -452,9 +452,7 @@ bool FaceTracker::StartFollow(Time stamp, double scale) {
     head_turn_.radius_px = depth * scale;
     head_turn_.yaw = depth > 0.0 ? fitted_yaw_ : 0.0;
     // PnP's rate, within what one frame's turn may be (HeadTurn).
-    head_turn_.yaw_rate =
-        depth > 0.0 ? std::max(-kHeadTurnMaxRate, std::min(kHeadTurnMaxRate, fitted_yaw_rate_))
-                    : 0.0;
+    head_turn_.yaw_rate = depth > 0.0 ? ClipTurnRate(fitted_yaw_rate_) : 0.0;
     head_turn_.axis_px =
         Mean(last_landmarks_) + Eigen::Vector2d(head_turn_.radius_px * std::sin(head_turn_.yaw), 0);
     return true;

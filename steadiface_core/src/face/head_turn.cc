@@ -56,7 +56,7 @@ bool UpdateHeadTurn(const RegionFlow& flow, HeadTurn* head) {
       residual += e * e;
     }
     residual = std::max(residual / (n - 2), kHeadTurnFlowSdFloor * kHeadTurnFlowSdFloor);
-    const double measured = std::max(-kHeadTurnMaxRate, std::min(kHeadTurnMaxRate, -slope));
+    const double measured = ClipTurnRate(-slope);
     const double measured_var = residual / (n * var);
     const double gain = head->yaw_rate_var / (head->yaw_rate_var + measured_var);
     head->yaw_rate += gain * (measured - head->yaw_rate);

@@ -15,15 +15,21 @@ namespace steadiface {
 /// at face value, and a frame with no spread of depths (or a wrong turn)
 /// handed the whole turning flow to the axis: turned 3.6 rad at 3x the
 /// preset's head motion, turn_away's axis slid 90 px off the head in ten
-/// frames. The rate's standard deviation may change by this much per
-/// frame (a head's turn speeding up or slowing down) [rad/frame].
+/// frames. The rate itself may change from one frame to the next by about
+/// this much (a standard deviation: a head's turn speeding up or slowing
+/// down) [rad/frame per frame].
 constexpr double kHeadTurnRateProcessSd = 0.01;
+/// The rate's standard deviation when a follow takes the rate of the last
+/// fits (PnP's, filtered) [rad/frame].
+constexpr double kHeadTurnRateStartSd = 0.06;
 /// The largest turn per frame a head is taken to make: one frame's
 /// measured turn and a follow's starting rate are clipped to it [rad/frame].
 constexpr double kHeadTurnMaxRate = 0.15;
-/// ... and starts at this when a follow takes the rate of the last fits
-/// (PnP's, filtered) [rad/frame].
-constexpr double kHeadTurnRateStartSd = 0.06;
+/// `rate` within +-kHeadTurnMaxRate [rad/frame].
+inline double ClipTurnRate(double rate) {
+  return rate < -kHeadTurnMaxRate ? -kHeadTurnMaxRate
+                                  : (rate > kHeadTurnMaxRate ? kHeadTurnMaxRate : rate);
+}
 /// A track's flow is taken as no more precise than this, whatever the
 /// residuals of one frame's fit (a cylinder's flow fits exactly only in
 /// the simulator) [px].
