@@ -120,6 +120,37 @@ TEST(HeadReliefTest, TheNearestSurfaceHidesWhatIsBehindIt) {
   EXPECT_GT(drawn, 50);
 }
 
+TEST(HeadReliefTest, TheBreadthSetsWhereTheSidesReachThePivot) {
+  // Across the ellipse's middle row, away from the nose, the depth is the
+  // pivot's times 1 - sqrt(1 - (x / half breadth)^2): at the half breadth
+  // the pivot's own, at half of it 0.134 of it. Without a breadth the
+  // outline is outline_radius of the texture's half width.
+  const cv::Size size(169, 189);  // odd: the middle row and column are texels
+  const Eigen::Vector2d centre(84.0, 40.0);  // the nose far above the middle row
+  const double w = 88.0;                     // face width [texels]
+  HeadReliefOptions o;
+  o.nose_below = 0.0;
+  const double cx = 84.0;
+  const int row = 94;
+  for (double breadth : {1.0, 1.25}) {  // half breadths of whole texels
+    o.breadth_face_widths = breadth;
+    const cv::Mat d = MakeHeadRelief(size, centre, w, o);
+    const double half = 0.5 * breadth * w;
+    EXPECT_NEAR(ReliefDepth(d, Eigen::Vector2d(cx, row)), 0.0, 1e-4);  // the nose's tail
+    EXPECT_NEAR(ReliefDepth(d, Eigen::Vector2d(cx + 0.5 * half, row)),
+                o.pivot_depth_m * (1.0 - std::sqrt(0.75)), 1e-3);
+    EXPECT_NEAR(ReliefDepth(d, Eigen::Vector2d(cx - half, row)), o.pivot_depth_m, 1e-3);
+    EXPECT_NEAR(ReliefDepth(d, Eigen::Vector2d(cx + half + 5.0, row)), o.pivot_depth_m, 1e-4);
+  }
+  o.breadth_face_widths = 0.0;
+  const cv::Mat d = MakeHeadRelief(size, centre, w, o);
+  const double half = o.outline_radius * 0.5 * size.width;
+  EXPECT_NEAR(ReliefDepth(d, Eigen::Vector2d(cx + 0.5 * half, row)),
+              o.pivot_depth_m * (1.0 - std::sqrt(0.75)), 1e-3);
+  EXPECT_NEAR(ReliefDepth(d, Eigen::Vector2d(cx + half + 2.0, row)), o.pivot_depth_m, 1e-4);
+  EXPECT_LT(ReliefDepth(d, Eigen::Vector2d(cx + 0.9 * half, row)), 0.6 * o.pivot_depth_m);
+}
+
 }  // namespace
 }  // namespace sim
 }  // namespace steadiface

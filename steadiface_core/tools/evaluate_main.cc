@@ -48,6 +48,8 @@ const char kUsage[] =
     "         at most once per S while no face is locked; 0 = every frame)\n"
     "       [--head-model relief|flat] (the simulated head: a relief that turns\n"
     "         about its skull, the default, or the flat photo)\n"
+    "       [--head-breadth B] (the relief's breadth where its sides reach the\n"
+    "         pivot's depth, in face widths; default the portrait's outline, 1.62)\n"
     "       [--pivot-depth D] (dynamic.pose_pivot_depth: the pose-invariant head\n"
     "         centre, D face scales behind the landmarks; 0 = the paper's centre)\n"
     "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
@@ -110,6 +112,7 @@ void AddRunFlags(CommandLine* cl, EvaluationOptions* o) {
     o->head_model = v;
     return v == "relief" || v == "flat";
   });
+  cl->Double("--head-breadth", &o->head_breadth);
   cl->Flag("--feasible-set", &o->feasible_set).Double("--feasible-roll", &o->feasible_roll);
   cl->Flag("--reach-tube", &o->reach_tube).Flag("--composite-frames", &o->composite_frames);
   cl->Int("--average15", &o->average_at);

@@ -82,6 +82,7 @@ Status MakeSimulator(const EvaluationOptions& o, const std::string& preset,
   if (s.ok()) s = SetHeadTurn(o.head_yaw_rad, o.head_turn_speed, &so->head);
   if (s.ok()) s = ScaleHeadMotion(o.head_motion_scale, o.head_jitter_scale, &so->head);
   if (!o.head_model.empty()) so->head_model = o.head_model;
+  if (std::isfinite(o.head_breadth)) so->relief.breadth_face_widths = o.head_breadth;
   if (s.ok()) s = sim::Simulator::Create(*so, sim);
   if (s.ok() && !std::isfinite(o.duration_s) && (*sim)->real_gyro_span_s() > so->duration_s) {
     // The whole recorded trace once (a 3 s slice of it is a poor sample).

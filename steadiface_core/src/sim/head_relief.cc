@@ -142,8 +142,13 @@ cv::Mat MakeHeadRelief(const cv::Size& size,
                        double face_width_px, const HeadReliefOptions& o) {
   cv::Mat depth(size, CV_32F);
   const double cx = 0.5 * (size.width - 1), cy = 0.5 * (size.height - 1);
-  const double ax = 0.5 * size.width, ay = 0.5 * size.height;
   const double w = std::max(1.0, face_width_px);
+  // The ellipse's half-axes, so that its outline (outline_radius of them)
+  // lies across at half the head's breadth when one is given.
+  const double ax = o.breadth_face_widths > 0.0
+                        ? 0.5 * o.breadth_face_widths * w / o.outline_radius
+                        : 0.5 * size.width;
+  const double ay = 0.5 * size.height;
   const Eigen::Vector2d nose(face_centre_uv.x(),
                              face_centre_uv.y() + o.nose_below * w);
   for (int y = 0; y < size.height; ++y) {

@@ -261,10 +261,11 @@ Status Simulator::Create(const SimulatorOptions& options, std::unique_ptr<Simula
   if (!(o.relief.pivot_depth_m > 0.0 && o.relief.pivot_depth_m < 0.5) ||
       !(o.relief.outline_radius > 0.1 && o.relief.outline_radius <= 1.0) ||
       !(std::abs(o.relief.nose_height_m) < 0.1) || !(o.relief.nose_sigma_x > 0.0) ||
-      !(o.relief.nose_sigma_y > 0.0) || !std::isfinite(o.relief.nose_below)) {
+      !(o.relief.nose_sigma_y > 0.0) || !std::isfinite(o.relief.nose_below) ||
+      !(o.relief.breadth_face_widths >= 0.0 && o.relief.breadth_face_widths <= 5.0)) {
     return Status::Error(
         "sim: relief pivot depth in (0, 0.5) m, outline radius in (0.1, 1], "
-        "nose height under 0.1 m, nose sigmas positive");
+        "nose height under 0.1 m, nose sigmas positive, breadth in [0, 5] face widths");
   }
   if (!(o.background_contrast > 0.0 && o.background_contrast <= 1.0) ||
       !(o.background_blur_px >= 0.0 && o.background_blur_px <= 50.0)) {

@@ -77,6 +77,9 @@ struct EvaluationOptions {
   double head_turn_speed = NAN;
   /// The simulated head: relief or flat (empty: the simulator's default).
   std::string head_model;
+  /// The relief head's breadth [face widths] (NaN: the simulator's; see
+  /// sim::HeadReliefOptions::breadth_face_widths).
+  double head_breadth = NAN;
 
   /// output.crop_ratio [-].
   double crop = NAN;

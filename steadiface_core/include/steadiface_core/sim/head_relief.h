@@ -21,6 +21,14 @@ struct HeadReliefOptions {
   /// depth at this fraction of the ellipse's radius; beyond it, the mask's
   /// feathered rim stays at that depth [-].
   double outline_radius = 0.85;
+  /// The head's breadth where its sides reach the pivot's depth, in face
+  /// widths [-]; 0: the billboard's outline (outline_radius of its width:
+  /// 1.62 face widths for the default portrait, which includes hair and
+  /// background around the face). A real head is about as broad as its
+  /// face (a 15 cm face, a 15-16 cm head); a broad relief puts the face's
+  /// sides, where its jaw landmarks sit, nearly in the plane of its front.
+  /// Beyond that breadth the relief stays at the pivot's depth.
+  double breadth_face_widths = 0.0;
   /// The nose: how far its tip stands in front of the face's plane [m], its
   /// width and length (Gaussian sigmas, as fractions of the face's width)
   /// and its centre below the landmarks' centre [face widths].
@@ -33,7 +41,8 @@ struct HeadReliefOptions {
 /// billboard's `anchor_px` and `metres_per_px`, the landmarks' centre
 /// `face_centre_uv` and the face's width `face_width_px` in texels): an
 /// ellipsoid whose front is the photo's plane and whose outline curves back
-/// to the pivot's depth, plus a nose. CV_32F, metres along the billboard's
+/// to the pivot's depth (across, at options.breadth_face_widths when set),
+/// plus a nose. CV_32F, metres along the billboard's
 /// local z (away from the viewer; the nose is negative).
 cv::Mat MakeHeadRelief(const cv::Size& texture_size,
                        const Eigen::Vector2d& face_centre_uv,
