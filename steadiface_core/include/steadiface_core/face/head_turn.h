@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+
 #include <Eigen/Core>
 
 #include "steadiface_core/face/head_region_motion.h"
@@ -27,8 +29,7 @@ constexpr double kHeadTurnRateStartSd = 0.06;
 constexpr double kHeadTurnMaxRate = 0.15;
 /// `rate` within +-kHeadTurnMaxRate [rad/frame].
 inline double ClipTurnRate(double rate) {
-  return rate < -kHeadTurnMaxRate ? -kHeadTurnMaxRate
-                                  : (rate > kHeadTurnMaxRate ? kHeadTurnMaxRate : rate);
+  return std::clamp(rate, -kHeadTurnMaxRate, kHeadTurnMaxRate);
 }
 /// A track's flow is taken as no more precise than this, whatever the
 /// residuals of one frame's fit (a cylinder's flow fits exactly only in
