@@ -1,13 +1,16 @@
 #include "steadiface_core/face/face_tracker.h"
 
 #include <cmath>
+#include <fstream>
 #include <iostream>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "steadiface_core/face/face_detector.h"
 #include "steadiface_core/face/generic_face.h"
 #include "steadiface_core/face/head_pose.h"
+#include "steadiface_core/face/landmark_predictor.h"
 #include "rendered_face.h"
 #include "test_util.h"
 
@@ -367,6 +370,29 @@ TEST(HeadPoseTest, RecoversKnownRotationsOfTheGenericFace) {
     EXPECT_NEAR(pitch, ypr[1], 0.02);
     EXPECT_NEAR(roll, ypr[2], 0.02);
   }
+}
+
+TEST(PortraitLandmarksTest, TheSimulatorsAreWhatDlibFinds) {
+  // test/data/astronaut_landmarks68.txt (the simulated mean-face head
+  // uses it) is what the face detector and dlib's 68-point model find on
+  // the portrait, to 0.02 px.
+  const cv::Mat photo = cv::imread(testing_util::DataPath("astronaut.png"), cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(photo.empty());
+  std::unique_ptr<FaceDetector> detector;
+  ASSERT_TRUE(FaceDetector::Create(FaceDetectorOptions(), &detector).ok());
+  std::vector<FaceBox> boxes;
+  ASSERT_TRUE(detector->Detect(photo, cv::Rect(0, 0, photo.cols, photo.rows), &boxes).ok());
+  ASSERT_FALSE(boxes.empty());
+  std::unique_ptr<LandmarkPredictor> predictor;
+  ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &predictor).ok());
+  std::vector<Eigen::Vector2d> found;
+  ASSERT_TRUE(predictor->Predict(photo, boxes[0].rect, &found).ok());
+  std::ifstream in(testing_util::DataPath("astronaut_landmarks68.txt"));
+  std::vector<Eigen::Vector2d> stored;
+  double x = 0.0, y = 0.0;
+  while (in >> x >> y) stored.emplace_back(x, y);
+  ASSERT_EQ(stored.size(), found.size());
+  for (size_t i = 0; i < stored.size(); ++i) EXPECT_LT((stored[i] - found[i]).norm(), 0.02) << i;
 }
 
 }  // namespace

@@ -1,11 +1,16 @@
 #include "steadiface_core/sim/head_relief.h"
 
 #include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "steadiface_core/camera/camera_intrinsics.h"
+#include "steadiface_core/sim/mean_face.h"
+#include "steadiface_core/sim/simulator.h"
 
 namespace steadiface {
 namespace sim {
@@ -149,6 +154,79 @@ TEST(HeadReliefTest, TheBreadthSetsWhereTheSidesReachThePivot) {
               o.pivot_depth_m * (1.0 - std::sqrt(0.75)), 1e-3);
   EXPECT_NEAR(ReliefDepth(d, Eigen::Vector2d(cx + half + 2.0, row)), o.pivot_depth_m, 1e-4);
   EXPECT_LT(ReliefDepth(d, Eigen::Vector2d(cx + 0.9 * half, row)), 0.6 * o.pivot_depth_m);
+}
+
+// The simulator's portrait landmarks, in its billboard's texels.
+std::vector<Eigen::Vector2d> PortraitLandmarksUv(const SimulatorOptions& so) {
+  std::ifstream in(std::string(STEADIFACE_TEST_DATA_DIR) + "/" + so.face_landmarks);
+  std::vector<Eigen::Vector2d> uv;
+  double x = 0.0, y = 0.0;
+  while (in >> x >> y) uv.emplace_back(x - so.face_region.x, y - so.face_region.y);
+  return uv;
+}
+
+TEST(MeanFaceTest, IsAsDeepAsTheMeanHumanFace) {
+  // A published mean 3D face of the 68 landmarks (OpenFace's in-the-wild
+  // mean shape, 14.5 cm between the jaw ends) puts, relative to the eyes'
+  // mean, the jaw's ends 4.6 cm behind and the nose tip 3.7 cm in front, the
+  // chin 0.2 cm in front and the outer brows 1.2 cm behind.
+  const auto& f = MeanFace68();
+  ASSERT_EQ(f.size(), 68u);
+  const double s = 0.145 / (f[16] - f[0]).head<2>().norm();
+  double eyes = 0.0;
+  for (int i = 36; i < 48; ++i) eyes += f[i].z() / 12.0;
+  EXPECT_NEAR(eyes, 0.0, 1e-9);  // the origin's depth
+  EXPECT_NEAR(s * f[0].z(), 0.046, 0.003);
+  EXPECT_NEAR(s * f[16].z(), 0.046, 0.003);
+  EXPECT_NEAR(s * f[30].z(), -0.037, 0.003);
+  EXPECT_NEAR(s * f[8].z(), -0.002, 0.003);
+  EXPECT_NEAR(s * f[17].z(), 0.012, 0.003);
+}
+
+TEST(HeadReliefTest, TheMeanFaceGivesEachLandmarkItsDepth) {
+  // On the simulator's portrait each landmark's depth is the mean face's,
+  // scaled from its 0.14 m jaw to the photo's: the eyes' mean on the plane.
+  const SimulatorOptions so;
+  const std::vector<Eigen::Vector2d> uv = PortraitLandmarksUv(so);
+  ASSERT_EQ(uv.size(), 68u);
+  const double mpt = so.face_width_m / so.face_width_px;
+  HeadReliefOptions o = so.relief;
+  o.nose_height_m = 0.0;
+  o.breadth_face_widths = 1.1;
+  cv::Mat d = MakeHeadRelief(cv::Size(so.face_region.width, so.face_region.height),
+                             so.face_centre_px - Eigen::Vector2d(so.face_region.x, so.face_region.y),
+                             so.face_width_px, o);
+  const cv::Mat ellipsoid = d.clone();
+  ASSERT_TRUE(AddMeanFaceDepths(uv, mpt, o.mean_face_sigma, &d));
+  const auto& face = MeanFace68();
+  const double scale = (uv[16] - uv[0]).norm() * mpt / (face[16] - face[0]).head<2>().norm();
+  double eyes = 0.0;
+  for (int i = 36; i < 48; ++i) eyes += ReliefDepth(d, uv[i]) / 12.0;
+  double worst = 0.0;
+  for (int i = 0; i < 68; ++i) {
+    worst = std::max(worst, std::abs(ReliefDepth(d, uv[i]) - eyes - scale * face[i].z()));
+  }
+  EXPECT_LT(worst, 0.0015) << "m";
+  EXPECT_NEAR(eyes, 0.0, 0.0015);
+  // Far from the face (the texture's corner) the ellipsoid is untouched.
+  EXPECT_NEAR(d.at<float>(2, 2), ellipsoid.at<float>(2, 2), 1e-6);
+  // Bad landmarks leave the relief as it was.
+  cv::Mat unchanged = ellipsoid.clone();
+  EXPECT_FALSE(AddMeanFaceDepths(std::vector<Eigen::Vector2d>(5), mpt, 0.06, &unchanged));
+  EXPECT_EQ(cv::norm(unchanged, ellipsoid, cv::NORM_INF), 0.0);
+}
+
+TEST(HeadReliefTest, AMeanFaceWithoutItsLandmarksIsAClearError) {
+  SimulatorOptions so;
+  so.data_dir = STEADIFACE_TEST_DATA_DIR;
+  so.duration_s = 0.2;
+  so.relief.mean_face = true;
+  std::unique_ptr<Simulator> sim;
+  EXPECT_TRUE(Simulator::Create(so, &sim).ok());
+  so.face_landmarks = "no_such_landmarks.txt";
+  const Status s = Simulator::Create(so, &sim);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("no_such_landmarks.txt"), std::string::npos) << s.message();
 }
 
 }  // namespace

@@ -46,8 +46,10 @@ const char kUsage[] =
     "         trace: scale its rotation, or play it K times as fast)\n"
     "       [--search-interval S] (face.search_interval: full-frame face search\n"
     "         at most once per S while no face is locked; 0 = every frame)\n"
-    "       [--head-model relief|flat] (the simulated head: a relief that turns\n"
-    "         about its skull, the default, or the flat photo)\n"
+    "       [--head-model relief|mean-face|flat] (the simulated head: the photo\n"
+    "         on an ellipsoid with a nose that turns about its skull, the\n"
+    "         default; that relief with the mean 3D face's depths at the\n"
+    "         photo's landmarks, 1.1 face widths broad; or the flat photo)\n"
     "       [--head-breadth B] (the relief's breadth where its sides reach the\n"
     "         pivot's depth, in face widths; default the portrait's outline, 1.62)\n"
     "       [--pivot-depth D] (dynamic.pose_pivot_depth: the pose-invariant head\n"
@@ -108,9 +110,9 @@ void AddRunFlags(CommandLine* cl, EvaluationOptions* o) {
   cl->Double("--head-distance", &o->head_distance_m);
   cl->Double("--head-motion", &o->head_motion_scale).Double("--head-jitter", &o->head_jitter_scale);
   cl->Double("--head-yaw", &o->head_yaw_rad).Double("--head-turn-speed", &o->head_turn_speed);
-  cl->Value("--head-model", "relief or flat", [o](const std::string& v) {
+  cl->Value("--head-model", "relief, mean-face or flat", [o](const std::string& v) {
     o->head_model = v;
-    return v == "relief" || v == "flat";
+    return v == "relief" || v == "mean-face" || v == "flat";
   });
   cl->Double("--head-breadth", &o->head_breadth);
   cl->Flag("--feasible-set", &o->feasible_set).Double("--feasible-roll", &o->feasible_roll);

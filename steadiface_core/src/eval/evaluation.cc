@@ -81,7 +81,12 @@ Status MakeSimulator(const EvaluationOptions& o, const std::string& preset,
   if (std::isfinite(o.head_distance_m)) so->head.distance_m = o.head_distance_m;
   if (s.ok()) s = SetHeadTurn(o.head_yaw_rad, o.head_turn_speed, &so->head);
   if (s.ok()) s = ScaleHeadMotion(o.head_motion_scale, o.head_jitter_scale, &so->head);
-  if (!o.head_model.empty()) so->head_model = o.head_model;
+  if (!o.head_model.empty()) {
+    so->head_model = o.head_model == "flat" ? "flat" : "relief";
+    so->relief.mean_face = o.head_model == "mean-face";
+    // A head about as broad as its face (a 15 cm face, a 16.5 cm head).
+    if (so->relief.mean_face) so->relief.breadth_face_widths = EvaluationOptions::kMeanFaceHeadBreadth;
+  }
   if (std::isfinite(o.head_breadth)) so->relief.breadth_face_widths = o.head_breadth;
   if (s.ok()) s = sim::Simulator::Create(*so, sim);
   if (s.ok() && !std::isfinite(o.duration_s) && (*sim)->real_gyro_span_s() > so->duration_s) {

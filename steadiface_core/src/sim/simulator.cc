@@ -262,10 +262,12 @@ Status Simulator::Create(const SimulatorOptions& options, std::unique_ptr<Simula
       !(o.relief.outline_radius > 0.1 && o.relief.outline_radius <= 1.0) ||
       !(std::abs(o.relief.nose_height_m) < 0.1) || !(o.relief.nose_sigma_x > 0.0) ||
       !(o.relief.nose_sigma_y > 0.0) || !std::isfinite(o.relief.nose_below) ||
-      !(o.relief.breadth_face_widths >= 0.0 && o.relief.breadth_face_widths <= 5.0)) {
+      !(o.relief.breadth_face_widths >= 0.0 && o.relief.breadth_face_widths <= 5.0) ||
+      !(o.relief.mean_face_sigma > 0.0 && o.relief.mean_face_sigma <= 0.5)) {
     return Status::Error(
         "sim: relief pivot depth in (0, 0.5) m, outline radius in (0.1, 1], "
-        "nose height under 0.1 m, nose sigmas positive, breadth in [0, 5] face widths");
+        "nose height under 0.1 m, nose sigmas positive, breadth in [0, 5] face widths, "
+        "mean-face sigma in (0, 0.5] face widths");
   }
   if (!(o.background_contrast > 0.0 && o.background_contrast <= 1.0) ||
       !(o.background_blur_px >= 0.0 && o.background_blur_px <= 50.0)) {
@@ -294,7 +296,8 @@ Status Simulator::Init() {
   const Eigen::Vector2d centre = (face_centre_uv_ - face_.anchor_px) * face_.metres_per_px;
   face_front_ = Eigen::Vector3d(centre.x(), centre.y(), 0.0);
   if (o.head_model == "relief") {
-    face_.depth_m = MakeHeadRelief(face_.bgra.size(), face_centre_uv_, o.face_width_px, o.relief);
+    const Status st = MakeRelief(m_per_px);
+    if (!st.ok()) return st;
     turning_centre_ = face_front_ + Eigen::Vector3d(0.0, 0.0, o.relief.pivot_depth_m);
   }
   face_.pose = [this](double t) { return FacePose(t, true); };

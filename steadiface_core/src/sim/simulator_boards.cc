@@ -1,8 +1,11 @@
-// The simulator's billboards: the face's pose, and the billboards besides
-// the face: the torso, the hair edge, the passer-by, the second face and
+// The simulator's billboards: the face's pose and relief, and the billboards
+// besides the face: the torso, the hair edge, the passer-by, the second face and
 // the occluding hand.
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -11,6 +14,18 @@
 
 namespace steadiface {
 namespace sim {
+namespace {
+
+// 68 "x y" lines (anything after them is ignored).
+bool ReadLandmarks(const std::string& path, std::vector<Eigen::Vector2d>* out) {
+  std::ifstream in(path);
+  out->clear();
+  double x = 0.0, y = 0.0;
+  while (out->size() < 68 && in >> x >> y) out->emplace_back(x, y);
+  return out->size() == 68;
+}
+
+}  // namespace
 
 Pose Simulator::FacePose(double t, bool turned) const {
   Pose P;
@@ -26,6 +41,25 @@ Pose Simulator::FacePose(double t, bool turned) const {
     P.p.x() += 0.6 * out;
   }
   return P;
+}
+
+Status Simulator::MakeRelief(double m_per_px) {
+  const SimulatorOptions& o = options_;
+  HeadReliefOptions ro = o.relief;
+  if (ro.mean_face) ro.nose_height_m = 0.0;  // the mean face has its own nose
+  face_.depth_m = MakeHeadRelief(face_.bgra.size(), face_centre_uv_, o.face_width_px, ro);
+  if (!ro.mean_face) return Status::Ok();
+  const std::string path = o.data_dir + "/" + o.face_landmarks;
+  std::vector<Eigen::Vector2d> uv;
+  if (!ReadLandmarks(path, &uv)) {
+    return Status::Error("sim: cannot read 68 landmarks (\"x y\" per line) from " + path);
+  }
+  const Eigen::Vector2d origin(o.face_region.x, o.face_region.y);
+  for (Eigen::Vector2d& p : uv) p -= origin;
+  if (!AddMeanFaceDepths(uv, m_per_px, ro.mean_face_sigma, &face_.depth_m)) {
+    return Status::Error("sim: the landmarks in " + path + " do not fit the face photo");
+  }
+  return Status::Ok();
 }
 
 void Simulator::MakeTorso() {

@@ -75,8 +75,13 @@ struct EvaluationOptions {
   /// turns, a head shaking "no".
   double head_yaw_rad = NAN;
   double head_turn_speed = NAN;
-  /// The simulated head: relief or flat (empty: the simulator's default).
+  /// The simulated head: "relief" (the photo on an ellipsoid with a nose,
+  /// the simulator's default), "mean-face" (that relief with the mean 3D
+  /// face's depths at the photo's landmarks, kMeanFaceHeadBreadth broad) or
+  /// "flat" (empty: the simulator's default).
   std::string head_model;
+  /// The mean-face head's breadth unless head_breadth sets it [face widths].
+  static constexpr double kMeanFaceHeadBreadth = 1.1;
   /// The relief head's breadth [face widths] (NaN: the simulator's; see
   /// sim::HeadReliefOptions::breadth_face_widths).
   double head_breadth = NAN;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <functional>
+#include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -25,9 +26,9 @@ struct HeadReliefOptions {
   /// widths [-]; 0: the billboard's outline (outline_radius of its width:
   /// 1.62 face widths for the default portrait, which includes hair and
   /// background around the face). A real head is about as broad as its
-  /// face (a 15 cm face, a 15-16 cm head); a broad relief puts the face's
-  /// sides, where its jaw landmarks sit, nearly in the plane of its front.
-  /// Beyond that breadth the relief stays at the pivot's depth.
+  /// face (a 15 cm face, a 15.5-16.5 cm head); a broad relief puts the
+  /// face's sides, where its jaw landmarks sit, nearly in the plane of its
+  /// front. Beyond that breadth the relief stays at the pivot's depth.
   double breadth_face_widths = 0.0;
   /// The nose: how far its tip stands in front of the face's plane [m], its
   /// width and length (Gaussian sigmas, as fractions of the face's width)
@@ -35,7 +36,28 @@ struct HeadReliefOptions {
   double nose_height_m = 0.02;
   double nose_sigma_x = 0.09, nose_sigma_y = 0.18;
   double nose_below = 0.08;
+  /// The face's own depths: at each of the photo's 68 landmarks the mean
+  /// face's (sim/mean_face.h), scaled to the photo's jaw width, carried
+  /// between them by Gaussians `mean_face_sigma` face widths wide and fading
+  /// into the ellipsoid beyond them (AddMeanFaceDepths). Replaces the
+  /// Gaussian nose. Needs the photo's landmarks
+  /// (SimulatorOptions::face_landmarks); `steadiface_evaluate --head-model
+  /// mean-face` turns it on with a breadth of 1.1.
+  bool mean_face = false;
+  double mean_face_sigma = 0.06;
 };
+
+/// Adds the mean face's (MeanFace68) depths at the photo's 68 landmarks
+/// (`landmarks_uv`, texels; `metres_per_texel`) to an ellipsoid relief
+/// `depth` (MakeHeadRelief without its nose): the landmarks get the mean
+/// face's depths, with the eyes' mean on the photo's plane (so the turning axis
+/// is the pivot's depth behind the eyes); Gaussian radial basis functions
+/// interpolate the change between them and let it fade beyond.
+/// Fails (false, `depth` unchanged) without 68 finite landmarks or a jaw
+/// wider than 1 texel.
+bool AddMeanFaceDepths(const std::vector<Eigen::Vector2d>& landmarks_uv,
+                       double metres_per_texel, double sigma_face_widths,
+                       cv::Mat* depth);
 
 /// The depth of a face billboard's texture (`texture_size` texels, the
 /// billboard's `anchor_px` and `metres_per_px`, the landmarks' centre

@@ -55,6 +55,10 @@ struct SimulatorOptions {
   cv::Rect face_region = cv::Rect(139, 38, 168, 188);
   Eigen::Vector2d face_centre_px = Eigen::Vector2d(224.1, 127.4);
   double face_width_px = 88.0;
+  /// The photo's 68 landmarks (data_dir/face_landmarks: one "x y" per line,
+  /// photo px; for astronaut.png, dlib's 68-point predictor's), which give
+  /// the relief its mean face (HeadReliefOptions::mean_face); "": none.
+  std::string face_landmarks = "astronaut_landmarks68.txt";
   /// Camera motion: parametric (pan + band-limited shake + translation) ...
   CameraMotionOptions camera;
   /// ... or the real recorded gyro trace (data_dir/gyro), scaled by
@@ -210,8 +214,10 @@ class Simulator {
  private:
   explicit Simulator(const SimulatorOptions& options);
   Status Init();
-  // Init's pieces: the torso billboard; the second face and the occluder;
-  // the recorded gyro trace (use_real_gyro); the IMU samples.
+  // Init's pieces: the face's relief (head_model "relief"); the torso
+  // billboard; the second face and the occluder; the recorded gyro trace
+  // (use_real_gyro); the IMU samples.
+  Status MakeRelief(double m_per_px);
   void MakeTorso();
   void MakeSecondFaceAndOccluder(const cv::Mat& photo, double m_per_px);
   Status LoadRealGyro();
