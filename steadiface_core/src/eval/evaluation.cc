@@ -85,7 +85,9 @@ Status MakeSimulator(const EvaluationOptions& o, const std::string& preset,
     so->head_model = o.head_model == "flat" ? "flat" : "relief";
     so->relief.mean_face = o.head_model == "mean-face";
     // A head about as broad as its face (a 15 cm face, a 16.5 cm head).
-    if (so->relief.mean_face) so->relief.breadth_face_widths = EvaluationOptions::kMeanFaceHeadBreadth;
+    if (so->relief.mean_face) {
+      so->relief.breadth_face_widths = EvaluationOptions::kMeanFaceHeadBreadth;
+    }
   }
   if (std::isfinite(o.head_breadth)) so->relief.breadth_face_widths = o.head_breadth;
   if (s.ok()) s = sim::Simulator::Create(*so, sim);

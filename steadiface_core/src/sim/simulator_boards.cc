@@ -1,6 +1,6 @@
-// The simulator's billboards: the face's pose and relief, and the billboards
-// besides the face: the torso, the hair edge, the passer-by, the second face and
-// the occluding hand.
+// The simulator's billboards: the face's pose and relief, and the
+// billboards besides the face: the torso, the hair edge, the passer-by, the
+// second face and the occluding hand.
 #include <algorithm>
 #include <cmath>
 #include <fstream>

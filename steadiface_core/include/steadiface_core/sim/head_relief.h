@@ -38,21 +38,23 @@ struct HeadReliefOptions {
   double nose_below = 0.08;
   /// The face's own depths: at each of the photo's 68 landmarks the mean
   /// face's (sim/mean_face.h), scaled to the photo's jaw width, carried
-  /// between them by Gaussians `mean_face_sigma` face widths wide and fading
-  /// into the ellipsoid beyond them (AddMeanFaceDepths). Replaces the
-  /// Gaussian nose. Needs the photo's landmarks
-  /// (SimulatorOptions::face_landmarks); `steadiface_evaluate --head-model
-  /// mean-face` turns it on with a breadth of 1.1.
+  /// between them by Gaussians and fading into the ellipsoid beyond them
+  /// (AddMeanFaceDepths). Replaces the Gaussian nose. Needs the photo's
+  /// landmarks (SimulatorOptions::face_landmarks); `steadiface_evaluate
+  /// --head-model mean-face` turns it on with a breadth of 1.1.
   bool mean_face = false;
+  /// Those Gaussians' sigma [face widths between the jaw ends]: 0.12 made
+  /// the interpolation overshoot between landmarks (creases).
   double mean_face_sigma = 0.06;
 };
 
 /// Adds the mean face's (MeanFace68) depths at the photo's 68 landmarks
 /// (`landmarks_uv`, texels; `metres_per_texel`) to an ellipsoid relief
 /// `depth` (MakeHeadRelief without its nose): the landmarks get the mean
-/// face's depths, with the eyes' mean on the photo's plane (so the turning axis
-/// is the pivot's depth behind the eyes); Gaussian radial basis functions
-/// interpolate the change between them and let it fade beyond.
+/// face's depths, with the eyes' mean on the photo's plane (so the turning
+/// axis is the pivot's depth behind the eyes); Gaussian radial basis
+/// functions (`sigma_face_widths`) interpolate the change between them and
+/// let it fade beyond.
 /// Fails (false, `depth` unchanged) without 68 finite landmarks or a jaw
 /// wider than 1 texel.
 bool AddMeanFaceDepths(const std::vector<Eigen::Vector2d>& landmarks_uv,
