@@ -1,7 +1,6 @@
 #include "steadiface_core/face/face_tracker.h"
 
 #include <cmath>
-#include <fstream>
 #include <iostream>
 
 #include <gtest/gtest.h>
@@ -11,6 +10,7 @@
 #include "steadiface_core/face/generic_face.h"
 #include "steadiface_core/face/head_pose.h"
 #include "steadiface_core/face/landmark_predictor.h"
+#include "steadiface_core/sim/head_relief.h"
 #include "rendered_face.h"
 #include "test_util.h"
 
@@ -387,10 +387,8 @@ TEST(PortraitLandmarksTest, TheSimulatorsAreWhatDlibFinds) {
   ASSERT_TRUE(LandmarkPredictor::Load(kDefaultShapePredictorPath, &predictor).ok());
   std::vector<Eigen::Vector2d> found;
   ASSERT_TRUE(predictor->Predict(photo, boxes[0].rect, &found).ok());
-  std::ifstream in(testing_util::DataPath("astronaut_landmarks68.txt"));
   std::vector<Eigen::Vector2d> stored;
-  double x = 0.0, y = 0.0;
-  while (in >> x >> y) stored.emplace_back(x, y);
+  sim::ReadPhotoLandmarks(testing_util::DataPath("astronaut_landmarks68.txt"), &stored);
   ASSERT_EQ(stored.size(), found.size());
   for (size_t i = 0; i < stored.size(); ++i) EXPECT_LT((stored[i] - found[i]).norm(), 0.5) << i;
 }

@@ -1,7 +1,6 @@
 #include "steadiface_core/sim/head_relief.h"
 
 #include <cmath>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -158,10 +157,9 @@ TEST(HeadReliefTest, TheBreadthSetsWhereTheSidesReachThePivot) {
 
 // The simulator's portrait landmarks, in its billboard's texels.
 std::vector<Eigen::Vector2d> PortraitLandmarksUv(const SimulatorOptions& so) {
-  std::ifstream in(std::string(STEADIFACE_TEST_DATA_DIR) + "/" + so.face_landmarks);
   std::vector<Eigen::Vector2d> uv;
-  double x = 0.0, y = 0.0;
-  while (in >> x >> y) uv.emplace_back(x - so.face_region.x, y - so.face_region.y);
+  ReadPhotoLandmarks(std::string(STEADIFACE_TEST_DATA_DIR) + "/" + so.face_landmarks, &uv);
+  for (Eigen::Vector2d& p : uv) p -= Eigen::Vector2d(so.face_region.x, so.face_region.y);
   return uv;
 }
 

@@ -1,6 +1,8 @@
-// The simulated head's mean face: AddMeanFaceDepths (sim/head_relief.h).
+// The simulated head's mean face: ReadPhotoLandmarks and AddMeanFaceDepths
+// (sim/head_relief.h).
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 
 #include <Eigen/Cholesky>
 
@@ -30,6 +32,14 @@ Eigen::VectorXd LandmarkChanges(const std::vector<Eigen::Vector2d>& uv, double m
 }
 
 }  // namespace
+
+bool ReadPhotoLandmarks(const std::string& path, std::vector<Eigen::Vector2d>* out) {
+  std::ifstream in(path);
+  out->clear();
+  double x = 0.0, y = 0.0;
+  while (out->size() < landmarks68::kCount && in >> x >> y) out->emplace_back(x, y);
+  return out->size() == landmarks68::kCount;
+}
 
 bool AddMeanFaceDepths(const std::vector<Eigen::Vector2d>& uv, double metres_per_texel,
                        double sigma_face_widths, cv::Mat* depth) {

@@ -3,7 +3,6 @@
 // second face and the occluding hand.
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -14,18 +13,6 @@
 
 namespace steadiface {
 namespace sim {
-namespace {
-
-// 68 "x y" lines (anything after them is ignored).
-bool ReadLandmarks(const std::string& path, std::vector<Eigen::Vector2d>* out) {
-  std::ifstream in(path);
-  out->clear();
-  double x = 0.0, y = 0.0;
-  while (out->size() < 68 && in >> x >> y) out->emplace_back(x, y);
-  return out->size() == 68;
-}
-
-}  // namespace
 
 Pose Simulator::FacePose(double t, bool turned) const {
   Pose P;
@@ -51,7 +38,7 @@ Status Simulator::MakeRelief(double m_per_px) {
   if (!ro.mean_face) return Status::Ok();
   const std::string path = o.data_dir + "/" + o.face_landmarks;
   std::vector<Eigen::Vector2d> uv;
-  if (!ReadLandmarks(path, &uv)) {
+  if (!ReadPhotoLandmarks(path, &uv)) {
     return Status::Error("sim: cannot read 68 landmarks (\"x y\" per line) from " + path);
   }
   const Eigen::Vector2d origin(o.face_region.x, o.face_region.y);

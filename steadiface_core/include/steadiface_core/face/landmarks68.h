@@ -15,6 +15,7 @@ constexpr int kChin = 8;
 constexpr int kBrowFirst = 17, kBrowLast = 26;  ///< right brow 17-21, left 22-26
 constexpr int kNoseBridgeTop = 27;              ///< the bridge 27-30
 constexpr int kNoseTip = 30;
+constexpr int kNostrilFirst = 31, kNostrilLast = 35;  ///< the nose's base, right to left
 constexpr int kRightEyeFirst = 36, kRightEyeLast = 41;
 constexpr int kLeftEyeFirst = 42, kLeftEyeLast = 47;
 constexpr int kRightEyeOuter = 36, kLeftEyeOuter = 45;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -47,6 +48,10 @@ struct HeadReliefOptions {
   /// the interpolation overshoot between landmarks (creases).
   double mean_face_sigma = 0.06;
 };
+
+/// Reads a photo's 68 landmarks: one "x y" per line [photo px] (anything
+/// after the 68th is ignored). False when the file has fewer.
+bool ReadPhotoLandmarks(const std::string& path, std::vector<Eigen::Vector2d>* out);
 
 /// Adds the mean face's (MeanFace68) depths at the photo's 68 landmarks
 /// (`landmarks_uv`, texels; `metres_per_texel`) to an ellipsoid relief
