@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cmath>
 #include <iostream>
+#include <memory>
 
 #include <gtest/gtest.h>
 
@@ -391,6 +392,45 @@ TEST(StabilizerTest, DeterministicAndResettable) {
   for (size_t i = 0; i < a.frames_out.size(); ++i) {
     EXPECT_EQ(a.frames_out[i].R_v.coeffs(), b.frames_out[i].R_v.coeffs());
     EXPECT_EQ(a.frames_out[i].t, b.frames_out[i].t);
+  }
+}
+
+// The evaluation's perfect tracker (steadiface_evaluate --true-head): the
+// centre handed over is where that frame's landmarks are taken to be, on
+// that frame only. Without the pose-invariant shift (pivot 0) that is the
+// same as a face observed there.
+TEST(StabilizerTest, TheTrueHeadCentreMovesThatFramesFaceOnly) {
+  const CameraModel m = Model640x360();
+  sim::LandmarkSequenceOptions o = Walk();
+  o.duration_s = 1.0;
+  const sim::LandmarkSequence seq(m, o);
+  StabilizerOptions so;
+  so.dynamic.pose_pivot_depth = 0.0;
+  std::unique_ptr<Stabilizer> plain, handed, observed;
+  for (auto* s : {&plain, &handed, &observed}) {
+    ASSERT_TRUE(Stabilizer::Create(m, OutputOptions(), so, s).ok());
+  }
+  OrientationTimeline tl{OrientationTimelineOptions()};
+  for (const auto& g : seq.gyro()) tl.AddSample(g);
+  const int kAt = 10;
+  const Eigen::Vector2d shift(0.02, -0.01);
+  for (int i = 0; i <= kAt + 3; ++i) {
+    const auto& fr = seq.frames()[i];
+    FaceObservation moved = fr.observed;
+    if (i == kAt) {
+      ASSERT_TRUE(moved.valid);
+      for (auto& l : moved.landmarks) l += shift;
+      moved.centre += shift;
+      handed->SetTrueHeadCentre(moved.centre);
+    }
+    StabilizerFrame fp, fh, fo;
+    ASSERT_TRUE(plain->Process(fr.stamp, tl, seq.timing(), &fr.observed, &fp).ok());
+    ASSERT_TRUE(handed->Process(fr.stamp, tl, seq.timing(), &fr.observed, &fh).ok());
+    ASSERT_TRUE(observed->Process(fr.stamp, tl, seq.timing(), &moved, &fo).ok());
+    // (Equal but for rounding: the landmarks are moved by a difference.)
+    EXPECT_LT((fh.t - fo.t).norm(), 1e-9) << "frame " << i;
+    EXPECT_LT((fh.R_v.coeffs() - fo.R_v.coeffs()).norm(), 1e-9) << "frame " << i;
+    if (i == kAt) EXPECT_GT((fh.t - fp.t).norm(), 1e-4) << "the pose follows the centre handed over";
   }
 }
 

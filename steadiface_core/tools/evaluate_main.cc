@@ -54,6 +54,9 @@ const char kUsage[] =
     "         pivot's depth, in face widths; default the portrait's outline, 1.62)\n"
     "       [--pivot-depth D] (dynamic.pose_pivot_depth: the pose-invariant head\n"
     "         centre, D face scales behind the landmarks; 0 = the paper's centre)\n"
+    "       [--true-head] (diagnostic: the stabilizer is handed the simulator's\n"
+    "         true head centre in place of the tracker's pose-invariant centre\n"
+    "         on every frame with a face; what a perfect tracker would give)\n"
     "       [--head-distance M] (the subject's distance [m]: robot at 2.75 m\n"
     "         shows a 30 px face)\n"
     "       [--head-motion K] (the head's own motion against the scene, K times\n"
@@ -117,6 +120,7 @@ void AddRunFlags(CommandLine* cl, EvaluationOptions* o) {
   cl->Double("--head-breadth", &o->head_breadth);
   cl->Flag("--feasible-set", &o->feasible_set).Double("--feasible-roll", &o->feasible_roll);
   cl->Flag("--reach-tube", &o->reach_tube).Flag("--composite-frames", &o->composite_frames);
+  cl->Flag("--true-head", &o->true_head);
   cl->Int("--average15", &o->average_at);
 }
 

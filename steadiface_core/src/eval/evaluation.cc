@@ -264,7 +264,8 @@ Status PresetRun::RunPipeline(const std::string& name, Method m, bool video, Vid
   CompositeQualityScore cq;
   s = RunMethod(*sim_, m, po, o_.render || video || ap != nullptr, card.get(), &frames, sink,
                 composite ? &cq : nullptr,
-                o_.composite_frames ? o_.out_dir + "/composite_" + preset_ : std::string());
+                o_.composite_frames ? o_.out_dir + "/composite_" + preset_ : std::string(),
+                o_.true_head);
   if (!s.ok()) return s;
   if (composite) composite_rows->push_back(CompositeRow(preset_, cq));
   if (video) return Status::Ok();

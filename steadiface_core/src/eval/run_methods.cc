@@ -125,7 +125,8 @@ void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_off
 Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions& options,
                  bool render, Scorecard* card, std::vector<StabilizerFrame>* frames_out,
                  const std::function<Status(const cv::Mat&)>& on_output,
-                 CompositeQualityScore* composite_quality, const std::string& composite_frames) {
+                 CompositeQualityScore* composite_quality, const std::string& composite_frames,
+                 bool true_head) {
   if (method == Method::kNone) {
     cv::Mat frame;
     sim::SimTruth truth;
@@ -171,6 +172,10 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
     } else {
       frame = cv::Mat(sim.intrinsics().height, sim.intrinsics().width, CV_8UC1,
                       cv::Scalar(0));
+    }
+    if (true_head) {
+      const sim::SimTruth t = sim.Truth(i);
+      if (t.head_in_view) p->SetTrueHeadCentre(t.head_px);
     }
     PipelineFrame out;
     s = p->ProcessFrame(frame, stamp, nullptr, 0.0, &out);

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "steadiface_core/camera/lens_distortion.h"
 #include "steadiface_core/common/grey.h"
 #include "steadiface_core/common/stopwatch.h"
 #include "steadiface_core/view/crop_need.h"
@@ -447,6 +448,14 @@ Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
   f.timings.remap_ms = warper_->timings().remap_ms;
   *out = std::move(f);
   return s;
+}
+
+void Pipeline::SetTrueHeadCentre(const Eigen::Vector2d& pixel) {
+  // As the tracker's landmarks are: undistorted, then normalized.
+  Eigen::Vector2d ideal = pixel;
+  const CameraIntrinsics& k = model_.intrinsics();
+  if (k.HasDistortion() && !UndistortPixel(k, pixel, &ideal)) return;
+  stabilizer_->SetTrueHeadCentre(model_.PixelToNormalized(ideal));
 }
 
 Status Pipeline::UpdateStabilizerOptions(const StabilizerOptions& options) {

@@ -28,6 +28,13 @@ Eigen::Vector2d ClampNorm(const Eigen::Vector2d& v, double r) {
   return n > r && n > 0.0 ? Eigen::Vector2d(v * (r / n)) : v;
 }
 
+// The face moved so that its centre is at `centre` (landmarks with it).
+void MoveFaceTo(const Eigen::Vector2d& centre, FaceObservation* face) {
+  const Eigen::Vector2d d = centre - face->centre;
+  for (auto& l : face->landmarks) l += d;
+  face->centre = centre;
+}
+
 bool FaceUsable(const FaceObservation* face, const StabilizerOptions& o) {
   if (o.gyro_only || face == nullptr || !face->valid ||
       face->landmarks.empty() || face->confidence < o.min_face_confidence) {
@@ -101,6 +108,11 @@ void Stabilizer::SetCropRatio(double r) {
   protrusion_ = ProtrusionGeometry(model_, output_, options_.terms.protrusion_samples_per_edge);
 }
 
+void Stabilizer::SetTrueHeadCentre(const Eigen::Vector2d& centre) {
+  has_true_head_ = centre.allFinite();
+  true_head_ = centre;
+}
+
 void Stabilizer::Reset() {
   subject_ = LayerState();
   reach_limit_ = 0.0;
@@ -120,6 +132,8 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
                            const FaceObservation* face,
                            StabilizerFrame* frame) {
   const auto start = Clock::now();
+  const bool true_head = has_true_head_;  // this frame's only
+  has_true_head_ = false;
   LayerState& layer = subject_;
   StabilizerFrame f;
   double dt = 0.0;
@@ -133,6 +147,7 @@ Status Stabilizer::Process(Time stamp, const OrientationTimeline& timeline,
   FaceObservation handed;
   if (use_face) {
     invariant = pose_centre_.Apply(*face, dt);
+    if (true_head) MoveFaceTo(true_head_, &invariant);
     face = HandBackStep(layer, invariant, dt, f, &handed);
   } else {
     pose_centre_.Reset();

@@ -119,6 +119,10 @@ struct EvaluationOptions {
   bool reach_tube = false;
   /// Composite: every 15th frame's pictures (composite_<preset>_*.png).
   bool composite_frames = false;
+  /// Diagnostic: the stabilizer is handed the simulator's true head centre
+  /// in place of the tracker's pose-invariant centre on every frame with a
+  /// face (Pipeline::SetTrueHeadCentre): what a perfect tracker would give.
+  bool true_head = false;
   /// >= 0: <preset>_<method>_frame.png and _average15.png around that frame.
   int average_at = -1;
 };

@@ -69,13 +69,15 @@ inline bool ImuHasGap(const sim::SimulatorOptions& o) {
 /// renders (its matte and plate are made from the pictures) and, with
 /// `composite_quality`, is scored against the truth (CompositeQuality);
 /// `composite_frames`, a path prefix, also writes every 15th frame's
-/// picture (CompositeQuality::DumpFrames).
+/// picture (CompositeQuality::DumpFrames). `true_head`: the stabilizer is
+/// handed the true head centre (Pipeline::SetTrueHeadCentre) on every frame
+/// the head is in view.
 Status RunMethod(const sim::Simulator& sim, Method method,
                  const PipelineOptions& options, bool render,
                  Scorecard* card, std::vector<StabilizerFrame>* frames_out,
                  const std::function<Status(const cv::Mat&)>& on_output = nullptr,
                  CompositeQualityScore* composite_quality = nullptr,
-                 const std::string& composite_frames = std::string());
+                 const std::string& composite_frames = std::string(), bool true_head = false);
 
 }  // namespace eval
 }  // namespace steadiface

@@ -203,6 +203,12 @@ class Pipeline {
   /// video. Ignored in the other modes.
   void SetImuMissing(bool missing) { imu_missing_ = missing; }
 
+  /// Evaluation only (steadiface_evaluate --true-head): the next frame's
+  /// face has its pose-invariant head centre at `pixel` [raw image px], not
+  /// where the tracker puts it (Stabilizer::SetTrueHeadCentre; the
+  /// tracker's landmarks move with it, its yaw and every check stay).
+  void SetTrueHeadCentre(const Eigen::Vector2d& pixel);
+
   /// True when the gyro covers the frame's last row (plus nothing else is
   /// needed to process it).
   bool GyroCovers(Time stamp) const;

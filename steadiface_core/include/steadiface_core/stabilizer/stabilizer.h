@@ -196,6 +196,12 @@ class Stabilizer {
   /// (1 - 2 r) of the frame (OutputGeometry::WithCropRatio).
   void SetCropRatio(double r);
 
+  /// Evaluation only (steadiface_evaluate --true-head): the next Process()
+  /// takes `centre` [normalized] as its face's pose-invariant head centre,
+  /// the landmarks moved with it, in place of the tracker's. A frame
+  /// without a face stays without one. What a perfect tracker would give.
+  void SetTrueHeadCentre(const Eigen::Vector2d& centre);
+
   /// Forgets the trajectory (time jumped, new epoch). Counters are kept.
   void Reset();
 
@@ -341,6 +347,9 @@ class Stabilizer {
   SlowMotionFilter reach_anchor_;
   // SetReachLimit's bound on subject_reach [jaw widths]; <= 0: none.
   double reach_limit_ = 0.0;
+  // SetTrueHeadCentre's centre for the next Process() [normalized].
+  bool has_true_head_ = false;
+  Eigen::Vector2d true_head_ = Eigen::Vector2d::Zero();
   uint64_t reach_anchor_frame_ = 0;
   bool reach_anchor_fed_ = false;
 };
