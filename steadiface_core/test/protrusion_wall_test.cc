@@ -34,19 +34,23 @@ eval::Score RunWall(const sim::Simulator& s, eval::Method method,
   });
 }
 
-// vlog (seed 1) with 0.85 of the width kept: on one frame the stiff wall
-// held the face 12 px off its target (22 solver iterations, E_p at 0).
+// walk (seed 1) with 0.85 of the width kept: the stiff wall knocks the face
+// off its target where the margin runs out. (The event was found on vlog:
+// one frame held 12 px off, 22 solver iterations, E_p at 0. Since the
+// pose-invariant centre takes back part of the nod, vlog's path no longer
+// meets the wall; walk's does.)
 TEST(ProtrusionWallTest, AFaceHeldAtATightMarginIsNotKnockedOffItsTarget) {
-  const auto s = MakeSimulator("vlog");
+  const auto s = MakeSimulator("walk");
   const double stiff_alpha = StabilizerOptions().terms.protrusion_alpha;
   const eval::Score stiff =
       RunWall(*s, eval::Method::kSteadiface, stiff_alpha, 0.075);
   const eval::Score ours = RunWall(*s, eval::Method::kSteadiface, NAN, 0.075);
-  std::cout << "[ vlog, 0.85 kept ] head px: stiff wall "
+  std::cout << "[ walk, 0.85 kept ] head px: stiff wall "
             << stiff.head_jitter_px << " (largest step "
             << stiff.head_max_step_px << "), face's wall "
             << ours.head_jitter_px << " (" << ours.head_max_step_px << ")\n";
-  // Measured (seed 1): 1.87 px, largest step 12.06 px -> 1.18 px, 4.89 px.
+  // Measured: 3.74 px, largest step 17.10 px -> 1.68 px, 5.58 px (on vlog
+  // before the nod's share: 1.87 px, 12.06 px -> 1.18 px, 4.89 px).
   EXPECT_LT(ours.head_jitter_px, 0.8 * stiff.head_jitter_px);
   EXPECT_LT(ours.head_max_step_px, 0.6 * stiff.head_max_step_px);
   EXPECT_EQ(ours.undefined_fraction, 0.0);

@@ -32,8 +32,21 @@ void PoseInvariantCentre::FilterYaw(double yaw, double dt) {
   yaw_ += Gain(h, cutoff_hz) * (yaw - yaw_);
 }
 
+double PoseInvariantCentre::FilterNod(double pitch, double dt) {
+  if (!has_pitch_ || !(dt > 0.0)) {
+    pitch_ = pitch_mean_ = pitch;
+    has_pitch_ = true;
+    return 0.0;
+  }
+  const double h = std::min(dt, 1.0);
+  const double tau = options_.pose_yaw_time_constant_s;
+  pitch_ += (tau > 0.0 ? 1.0 - std::exp(-h / tau) : 1.0) * (pitch - pitch_);
+  pitch_mean_ += (1.0 - std::exp(-h / options_.pose_nod_time_constant_s)) * (pitch - pitch_mean_);
+  return pitch_ - pitch_mean_;
+}
+
 FaceObservation PoseInvariantCentre::Apply(const FaceObservation& face, double dt) {
-  last_shift_ = 0.0;
+  last_shift_ = last_nod_shift_ = 0.0;
   if (options_.pose_pivot_depth <= 0.0 || !face.valid || !face.has_pose ||
       !std::isfinite(face.yaw) || !(face.scale > 0.0)) {
     return face;
@@ -43,9 +56,20 @@ FaceObservation PoseInvariantCentre::Apply(const FaceObservation& face, double d
   // The landmarks' centre sits at -d sin(yaw) (x right) from where it would
   // be facing the camera: moved back by +d sin(yaw).
   last_shift_ = options_.pose_pivot_depth * face.scale * std::sin(yaw_);
+  // The nod moves them down by d sin(pitch) (y down): moved back by a
+  // share of it, fading out between pose_nod_max_yaw and twice it.
+  if (options_.pose_nod_gain > 0.0 && std::isfinite(face.pitch)) {
+    const double nod = FilterNod(face.pitch, dt);
+    const double lo = options_.pose_nod_max_yaw_rad;
+    const double u = std::min(1.0, std::max(0.0, (std::abs(yaw_) - lo) / lo));
+    const double keep = 1.0 - u * u * (3.0 - 2.0 * u);
+    last_nod_shift_ = -keep * options_.pose_nod_gain * options_.pose_pivot_depth * face.scale *
+                      std::sin(nod);
+  }
   FaceObservation out = face;
-  for (Eigen::Vector2d& l : out.landmarks) l.x() += last_shift_;
-  out.centre.x() += last_shift_;
+  const Eigen::Vector2d shift(last_shift_, last_nod_shift_);
+  for (Eigen::Vector2d& l : out.landmarks) l += shift;
+  out.centre += shift;
   return out;
 }
 

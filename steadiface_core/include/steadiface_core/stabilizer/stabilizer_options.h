@@ -113,6 +113,21 @@ struct DynamicWeightOptions {
   /// keeping PnP's frame-to-frame noise out (0.5 cost up to 10 % of head
   /// jitter on slow presets, docs/evaluation.md) [rad/s].
   double pose_yaw_speed_floor_rad_s = 0.8;
+  /// The nod: a head also pitches about its skull's centre, and its
+  /// landmarks move up and down by pose_pivot_depth times sin(pitch). They
+  /// are moved back by this share of that, the nod being PnP's pitch (low-
+  /// passed as the yaw is) above its slow mean. PnP's pitch is about as
+  /// noisy as a walking head's nod (0.012-0.014 against 0.015 rad RMS
+  /// above 0.5 Hz in the simulator), so less than the whole shift; 0 =
+  /// off [-].
+  double pose_nod_gain = 0.4;
+  /// Time constant of the slow mean the nod is taken from: a head held
+  /// tilted is not a nod, and PnP's pitch of a face is offset by the
+  /// face's own proportions [s].
+  double pose_nod_time_constant_s = 1.0;
+  /// The nod's shift fades out between this |yaw| and twice it: a turned
+  /// face's pitch from PnP is not its nod [rad].
+  double pose_nod_max_yaw_rad = 0.15;
   /// Frames in the landmark-variation window [count].
   int variation_window = 10;
   /// RMS second difference of the gyro-compensated landmark centre at which
