@@ -19,4 +19,9 @@ void ComputeCentreAndScale(FaceObservation* face) {
   face->scale = std::sqrt(s2 / face->landmarks.size());
 }
 
+void ShiftFace(const Eigen::Vector2d& d, FaceObservation* face) {
+  for (auto& l : face->landmarks) l += d;
+  face->centre += d;
+}
+
 }  // namespace steadiface

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "steadiface_core/stabilizer/dynamic_weights.h"
+
 namespace steadiface {
 namespace {
 
@@ -61,15 +63,12 @@ FaceObservation PoseInvariantCentre::Apply(const FaceObservation& face, double d
   if (options_.pose_nod_gain > 0.0 && std::isfinite(face.pitch)) {
     const double nod = FilterNod(face.pitch, dt);
     const double lo = options_.pose_nod_max_yaw_rad;
-    const double u = std::min(1.0, std::max(0.0, (std::abs(yaw_) - lo) / lo));
-    const double keep = 1.0 - u * u * (3.0 - 2.0 * u);
+    const double keep = 1.0 - SmoothStep(std::abs(yaw_), lo, 2.0 * lo);
     last_nod_shift_ = -keep * options_.pose_nod_gain * options_.pose_pivot_depth * face.scale *
                       std::sin(nod);
   }
   FaceObservation out = face;
-  const Eigen::Vector2d shift(last_shift_, last_nod_shift_);
-  for (Eigen::Vector2d& l : out.landmarks) l += shift;
-  out.centre += shift;
+  ShiftFace(Eigen::Vector2d(last_shift_, last_nod_shift_), &out);
   return out;
 }
 

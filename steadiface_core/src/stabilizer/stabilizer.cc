@@ -30,9 +30,8 @@ Eigen::Vector2d ClampNorm(const Eigen::Vector2d& v, double r) {
 
 // The face moved so that its centre is at `centre` (landmarks with it).
 void MoveFaceTo(const Eigen::Vector2d& centre, FaceObservation* face) {
-  const Eigen::Vector2d d = centre - face->centre;
-  for (auto& l : face->landmarks) l += d;
-  face->centre = centre;
+  ShiftFace(centre - face->centre, face);
+  face->centre = centre;  // exactly, not by a difference
 }
 
 bool FaceUsable(const FaceObservation* face, const StabilizerOptions& o) {
@@ -328,8 +327,7 @@ const FaceObservation* Stabilizer::HandBackStep(const LayerState& layer,
   }
   if (!handback_.allFinite()) handback_.setZero();
   *out = face;
-  for (auto& l : out->landmarks) l -= handback_;
-  out->centre -= handback_;
+  ShiftFace(-handback_, out);
   return out;
 }
 

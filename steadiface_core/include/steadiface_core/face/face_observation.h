@@ -33,4 +33,7 @@ struct FaceObservation {
 /// Fills centre and scale from landmarks.
 void ComputeCentreAndScale(FaceObservation* face);
 
+/// Moves the face by `d` [normalized]: its landmarks and its centre.
+void ShiftFace(const Eigen::Vector2d& d, FaceObservation* face);
+
 }  // namespace steadiface
