@@ -101,5 +101,34 @@ TEST(CompositeScenarioTest, AHeadTurnedPastTheLandmarksIsHeldAsInGlobalMode) {
   EXPECT_EQ(comp.undefined_fraction, 0.0);
 }
 
+TEST(CompositeScenarioTest, ThePlateFillsWhatAPanUncoversWithTheSceneItConfirmed) {
+  // pan: the camera pans, and the plate is reprojected as it goes. A plate
+  // pixel whose first value was wrong (a soft edge, a resampled border)
+  // turned the scene away as its outlier until it expired, and what the
+  // subject uncovered there fell back to the displaced scene. Replaced
+  // until four frames agree (composite/plate/confirm_frames), it holds the
+  // scene. Measured (seed 1): the output's error where the subject truly
+  // uncovered the scene 17.1 -> 9.9 grey levels, the fallback's share
+  // 0.45 -> 0.37.
+  auto s = MakeSimulator("pan");
+  eval::CompositeQualityScore q[2];
+  for (int i = 0; i < 2; ++i) {
+    PipelineOptions po = eval::OptionsFor(*s, eval::Method::kSteadifaceComposite);
+    if (i == 0) po.composite.plate.confirm_frames = 1;
+    ASSERT_EQ(po.composite.plate.confirm_frames, i == 0 ? 1 : 4);
+    std::unique_ptr<eval::Scorecard> card;
+    ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
+    const Status st = eval::RunMethod(*s, eval::Method::kSteadifaceComposite, po, false,
+                                      card.get(), nullptr, nullptr, &q[i]);
+    ASSERT_TRUE(st.ok()) << st.message();
+    std::cout << "[ pan ] confirm_frames " << po.composite.plate.confirm_frames
+              << ": uncovered MAE " << q[i].uncovered_mae << ", fallback " << q[i].fallback_share
+              << ", plate MAE " << q[i].plate_mae << "\n";
+  }
+  EXPECT_LT(q[1].uncovered_mae, 0.75 * q[0].uncovered_mae);
+  EXPECT_LT(q[1].fallback_share, q[0].fallback_share - 0.05);
+  EXPECT_LT(q[1].plate_mae, 1.05 * q[0].plate_mae);
+}
+
 }  // namespace
 }  // namespace steadiface

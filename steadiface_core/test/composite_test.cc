@@ -169,6 +169,53 @@ TEST(BackgroundPlateTest, RestartsOnAsceneCutAndOnALargeTurnAndReprojectsOnADrif
   EXPECT_EQ(plate.restarts(), 2);
 }
 
+// A fringe of the subject that the matte let through on one frame (a strip
+// of hair colour where the matte says scene), then the scene there. With
+// confirm_frames 1 the plate keeps the fringe while it is fresh (the scene
+// is its outlier); with the default the scene replaces it on the next frame.
+// A pixel that the scene has confirmed turns a fringe away.
+TEST(BackgroundPlateTest, TheSceneReplacesAFringeTakenFirstAndTurnsOneAwayOnceConfirmed) {
+  const OutputGeometry g = Geometry();
+  const Scene scene(g);
+  const cv::Size size(g.width(), g.height());
+  const cv::Rect roi(100, 60, 300, 200), strip(100, 50, 40, 100);  // strip: in the roi
+  const cv::Mat none = cv::Mat::zeros(roi.size(), CV_32F);
+  const LayerView v = OutputView(g, Eigen::Quaterniond::Identity(), Eigen::Vector2d::Zero());
+  const cv::Mat clean = scene.Render(v, size);
+  cv::Mat fringe = clean.clone();
+  fringe(roi)(strip).setTo(cv::Scalar(40, 60, 120));
+  cv::Mat strip_mask = cv::Mat::zeros(roi.size(), CV_8U);
+  strip_mask(strip).setTo(255);
+  const auto strip_error = [&](const BackgroundPlate& plate) {
+    cv::Mat colour, valid;
+    plate.Sample(roi, &colour, &valid);
+    EXPECT_EQ(cv::countNonZero((valid > 0.99) & strip_mask), strip.area());
+    return MeanAbs(colour, clean(roi), strip_mask);
+  };
+  ASSERT_EQ(BackgroundPlateOptions().confirm_frames, 4);
+  for (const int confirm : {1, 4}) {
+    SCOPED_TRACE(confirm);
+    BackgroundPlateOptions o;
+    o.confirm_frames = confirm;
+    BackgroundPlate plate(g, o);
+    for (int i = 0; i < 5; ++i) {
+      plate.Begin(v, i / 30.0);
+      ASSERT_TRUE(plate.Update((i == 0 ? fringe : clean)(roi), none, roi, 0.1f));
+      const double error = strip_error(plate);
+      if (i == 0 || confirm == 1) {
+        EXPECT_GT(error, 40.0) << "frame " << i;  // the fringe
+      } else {
+        EXPECT_LT(error, 3.0) << "frame " << i;  // the scene
+      }
+    }
+    // Four frames of the scene confirmed it (with 4): a fringe now is turned
+    // away. (With 1 the fringe taken first is still there.)
+    plate.Begin(v, 5 / 30.0);
+    ASSERT_TRUE(plate.Update(fringe(roi), none, roi, 0.1f));
+    if (confirm == 4) EXPECT_LT(strip_error(plate), 3.0);
+  }
+}
+
 // The subject region of a disc of radius r around c (head only).
 SubjectRegion Disc(const Eigen::Vector2d& c, double r) {
   SubjectRegion region;

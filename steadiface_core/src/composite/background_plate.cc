@@ -32,6 +32,9 @@ Status ValidateBackgroundPlateOptions(const BackgroundPlateOptions& o) {
   if (!In(o.outlier_level, 1.0, 255.0)) {
     return Status::Error("composite.plate: outlier_level must be in [1, 255]");
   }
+  if (o.confirm_frames < 1 || o.confirm_frames > 255) {
+    return Status::Error("composite.plate: confirm_frames must be in [1, 255]");
+  }
   if (!In(o.scene_cut_level, 1.0, 255.0)) {
     return Status::Error("composite.plate: scene_cut_level must be in [1, 255]");
   }
@@ -47,11 +50,13 @@ BackgroundPlate::BackgroundPlate(const OutputGeometry& output,
   plate_ = cv::Mat(output.height() + 2 * margin_y_, output.width() + 2 * margin_x_, CV_8UC3,
                    cv::Scalar::all(0));  // retyped on the first image of another type
   seen_ = cv::Mat(plate_.size(), CV_32F, cv::Scalar(kNever));
+  agreed_ = cv::Mat::zeros(plate_.size(), CV_8U);
 }
 
 void BackgroundPlate::Reset() {
   plate_.setTo(cv::Scalar::all(0));
   seen_.setTo(cv::Scalar(kNever));
+  agreed_.setTo(cv::Scalar(0));
   anchored_ = false;
 }
 
@@ -95,13 +100,16 @@ void BackgroundPlate::Reproject() {
   const Eigen::Matrix3d H = HomographyBetween(anchor_, next);
   const cv::Rect all(0, 0, plate_.cols, plate_.rows);
   const cv::Matx33d M = RectMap(H, all, 1.0, all, 1.0);
-  cv::Mat plate, seen;
+  cv::Mat plate, seen, agreed;
   cv::warpPerspective(plate_, plate, M, plate_.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
                       cv::BORDER_CONSTANT, cv::Scalar::all(0));
   cv::warpPerspective(seen_, seen, M, seen_.size(), cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
                       cv::BORDER_CONSTANT, cv::Scalar(kNever));
+  cv::warpPerspective(agreed_, agreed, M, agreed_.size(), cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
+                      cv::BORDER_CONSTANT, cv::Scalar(0));
   plate_ = plate;
   seen_ = seen;
+  agreed_ = agreed;
   anchor_ = next;
   ++reprojections_;
 }
@@ -145,6 +153,7 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
   if (image_roi.type() != plate_.type()) {
     plate_ = cv::Mat(plate_.size(), image_roi.type(), cv::Scalar::all(0));
     seen_.setTo(cv::Scalar(kNever));
+    agreed_.setTo(cv::Scalar(0));
   }
   const cv::Rect all(0, 0, plate_.cols, plate_.rows);
   const cv::Rect target = MapRect(PlateFromView(), roi, all);
@@ -184,6 +193,8 @@ void BackgroundPlate::UpdateRow(const cv::Mat& image, const cv::Mat& matte, int 
   const int cn = plate_.channels();
   uchar* p = plate_.ptr<uchar>(py) + cn * x0;
   float* seen = seen_.ptr<float>(py) + x0;
+  uchar* agreed = agreed_.ptr<uchar>(py) + x0;
+  const int confirm = options_.confirm_frames;
   const float now = static_cast<float>(now_), max_age = static_cast<float>(options_.max_age_s);
   const int outlier = static_cast<int>(options_.outlier_level * cn);
   // The running average's weight of this frame, in 1/256 steps.
@@ -215,18 +226,26 @@ void BackgroundPlate::UpdateRow(const cv::Mat& image, const cv::Mat& matte, int 
                                fy * ((1 - fx) * b[c] + fx * b[c + cn]) + 0.5f);
     }
     const bool fresh = now - seen[x] < max_age;
+    int d = 0;
     if (fresh) {
-      int d = 0;
       for (int c = 0; c < cn; ++c) d += std::abs(in[c] - p[c]);
       diff_sum += d;
       ++diff_count;
-      // A fresh pixel that disagrees this much is more likely a subject's
-      // edge than the scene: not taken; it expires if the scene really
-      // changed.
-      if (d > outlier) continue;
+    }
+    if (fresh && d <= outlier) {
       for (int c = 0; c < cn; ++c) p[c] = static_cast<uchar>(p[c] + ((rate * (in[c] - p[c]) + 128) >> 8));
+      if (agreed[x] < 255) ++agreed[x];
+    } else if (fresh && agreed[x] >= confirm) {
+      // A confirmed pixel that disagrees this much is more likely a
+      // subject's edge than the scene: not taken; it expires if the scene
+      // really changed.
+      continue;
     } else {
+      // New, expired, or an unconfirmed value this frame disagrees with
+      // (the value first taken may have been a subject's edge; kept, it
+      // would turn the scene away as its outlier until it expired).
       for (int c = 0; c < cn; ++c) p[c] = static_cast<uchar>(in[c]);
+      agreed[x] = 1;
     }
     seen[x] = now;
   }

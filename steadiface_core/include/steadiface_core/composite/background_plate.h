@@ -22,10 +22,17 @@ struct BackgroundPlateOptions {
   /// Weight of this frame where the plate already holds the pixel (the rest
   /// is the plate's; 1 = newest only) [-].
   double update_rate = 0.5;
-  /// A fresh pixel is not updated by a value that differs from it by more
-  /// than this (a subject's soft edge the matte let through); it expires
-  /// after max_age_s if the scene really changed [grey levels].
+  /// A fresh pixel that confirm_frames confirmed is not updated by a value
+  /// that differs from it by more than this (a subject's soft edge the
+  /// matte let through); it expires after max_age_s if the scene really
+  /// changed [grey levels].
   double outlier_level = 40.0;
+  /// A fresh pixel turns away a value beyond outlier_level only once this
+  /// many consecutive frames have agreed with it; before, such a value
+  /// replaces it. A subject's edge the matte let through moves on, and the
+  /// scene, standing still in the background layer's view, then replaces
+  /// it; 1 = the first value taken is kept while fresh [frames].
+  int confirm_frames = 4;
   /// The plate restarts when the background camera has turned by more than
   /// this since the plate's anchor [deg]; below it, the plate is reprojected
   /// once when the view leaves it.
@@ -43,8 +50,8 @@ Status ValidateBackgroundPlateOptions(const BackgroundPlateOptions& options);
 /// the output): colour and the time each pixel was last seen. The background
 /// layer's camera is gyro-stabilized, so the far scene stands still in it and
 /// what the subject uncovers was seen here a moment earlier. Memory: one
-/// image of the output plus its margin, and a float time per pixel. Causal;
-/// one per stream; not thread-safe.
+/// image of the output plus its margin, a float time and a byte of agreeing
+/// frames per pixel. Causal; one per stream; not thread-safe.
 class BackgroundPlate {
  public:
   BackgroundPlate(const OutputGeometry& output, const BackgroundPlateOptions& options);
@@ -86,6 +93,9 @@ class BackgroundPlate {
   double now() const { return now_; }
   /// Last time each pixel was seen [s]; -inf where never.
   const cv::Mat& seen() const { return seen_; }
+  /// Frames that agreed with each pixel since it was last replaced (CV_8U,
+  /// saturating).
+  const cv::Mat& agreed() const { return agreed_; }
 
  private:
   // Plate pixel <- output pixel of the current view.
@@ -94,8 +104,8 @@ class BackgroundPlate {
   // Update's step over `width` plate pixels of row py from x0: each takes
   // the picture (`image`, over output rectangle `roi`) at the view pixel G
   // maps it to, where `matte` (1/255 steps, over `roi`) is below `below`,
-  // unless it is a fresh pixel's outlier. Writes plate row py only, so
-  // rows may run in parallel.
+  // unless it is a confirmed pixel's outlier (an unconfirmed one is
+  // replaced). Writes plate row py only, so rows may run in parallel.
   void UpdateRow(const cv::Mat& image, const cv::Mat& matte, int below, const Eigen::Matrix3d& G,
                  const cv::Rect& roi, int x0, int py, int width, double* diff, int* compared);
   void Reproject();
@@ -105,6 +115,7 @@ class BackgroundPlate {
   const int margin_x_, margin_y_;
   cv::Mat plate_;  // CV_8UC3
   cv::Mat seen_;   // CV_32F
+  cv::Mat agreed_;  // CV_8U
   bool anchored_ = false;
   LayerView anchor_, view_;
   Eigen::Matrix3d view_to_plate_ = Eigen::Matrix3d::Identity();
