@@ -33,8 +33,9 @@ CompositeRun Score(const std::string& preset) {
     std::unique_ptr<eval::Scorecard> card;
     Status st = eval::MakeScorecard(*s, po, &card);
     if (st.ok()) {
-      st = eval::RunMethod(*s, m, po, false, card.get(), nullptr, nullptr,
-                           m == eval::Method::kSteadifaceComposite ? &r.quality : nullptr);
+      eval::RunMethodOptions run;
+      if (m == eval::Method::kSteadifaceComposite) run.composite_quality = &r.quality;
+      st = eval::RunMethod(*s, m, po, card.get(), run);
     }
     EXPECT_TRUE(st.ok()) << st.message();
     if (st.ok()) r.score[m] = card->Compute();
@@ -118,8 +119,9 @@ TEST(CompositeScenarioTest, ThePlateFillsWhatAPanUncoversWithTheSceneItConfirmed
     ASSERT_EQ(po.composite.plate.confirm_frames, i == 0 ? 1 : 4);
     std::unique_ptr<eval::Scorecard> card;
     ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
-    const Status st = eval::RunMethod(*s, eval::Method::kSteadifaceComposite, po, false,
-                                      card.get(), nullptr, nullptr, &q[i]);
+    eval::RunMethodOptions run;
+    run.composite_quality = &q[i];
+    const Status st = eval::RunMethod(*s, eval::Method::kSteadifaceComposite, po, card.get(), run);
     ASSERT_TRUE(st.ok()) << st.message();
     std::cout << "[ pan ] confirm_frames " << po.composite.plate.confirm_frames
               << ": uncovered MAE " << q[i].uncovered_mae << ", fallback " << q[i].fallback_share

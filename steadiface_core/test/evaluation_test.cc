@@ -60,7 +60,7 @@ TEST(EvaluationTest, RowsAreTheScorecardsOfTheSameRuns) {
   const PipelineOptions po = eval::OptionsFor(*sim, eval::Method::kGyroOnly);
   std::unique_ptr<eval::Scorecard> card;
   ASSERT_TRUE(eval::MakeScorecard(*sim, po, &card).ok());
-  ASSERT_TRUE(eval::RunMethod(*sim, eval::Method::kGyroOnly, po, false, card.get(), nullptr).ok());
+  ASSERT_TRUE(eval::RunMethod(*sim, eval::Method::kGyroOnly, po, card.get()).ok());
   const eval::Score sc = card->Compute();
   char expected[160];
   std::snprintf(expected, sizeof(expected), "| still | gyro-only | %.2f | %.3f |",

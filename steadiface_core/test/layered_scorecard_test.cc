@@ -30,7 +30,7 @@ eval::Score Score(const sim::Simulator& s, eval::Method m) {
   o.stabilizer.dynamic.pose_pivot_depth = 0.0;
   std::unique_ptr<eval::Scorecard> card;
   EXPECT_TRUE(eval::MakeScorecard(s, o, &card).ok());
-  const Status st = eval::RunMethod(s, m, o, false, card.get(), nullptr);
+  const Status st = eval::RunMethod(s, m, o, card.get());
   EXPECT_TRUE(st.ok()) << st.message();
   return card->Compute();
 }

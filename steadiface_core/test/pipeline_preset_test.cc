@@ -47,7 +47,7 @@ PresetResult Score(const std::string& preset, double crop_ratio = -1.0,
     if (crop_ratio >= 0.0) po.warp.output.crop_ratio = crop_ratio;
     std::unique_ptr<eval::Scorecard> card;
     Status st = eval::MakeScorecard(*s, po, &card);
-    if (st.ok()) st = eval::RunMethod(*s, method, po, false, card.get(), nullptr);
+    if (st.ok()) st = eval::RunMethod(*s, method, po, card.get());
     EXPECT_TRUE(st.ok()) << st.message();
     if (!st.ok()) continue;
     (method == eval::Method::kNone ? r.none : method == eval::Method::kGyroOnly ? r.gyro : r.full) =
@@ -94,8 +94,9 @@ TEST(PipelinePresetTest, TheTrueHeadCentreIsHeldBetterThanTheTrackers) {
     std::unique_ptr<eval::Scorecard> card;
     Status st = eval::MakeScorecard(*s, po, &card);
     if (st.ok()) {
-      st = eval::RunMethod(*s, eval::Method::kSteadiface, po, false, card.get(), nullptr, nullptr,
-                           nullptr, std::string(), true_head == 1);
+      eval::RunMethodOptions run;
+      run.true_head = true_head == 1;
+      st = eval::RunMethod(*s, eval::Method::kSteadiface, po, card.get(), run);
     }
     ASSERT_TRUE(st.ok()) << st.message();
     score[true_head] = card->Compute();
@@ -169,7 +170,9 @@ TEST(PipelinePresetTest, FaceLeavingAndReenteringFadesWithoutJumps) {
   std::unique_ptr<eval::Scorecard> card;
   ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
   std::vector<StabilizerFrame> frames;
-  ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadiface, po, false, card.get(), &frames).ok());
+  eval::RunMethodOptions run;
+  run.frames = &frames;
+  ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadiface, po, card.get(), run).ok());
   ASSERT_EQ(static_cast<int>(frames.size()), s->num_frames());
   double max_step = 0.0, min_fit_out = 1.0, max_fit_back = 0.0;
   int used_while_out = 0;
@@ -260,7 +263,7 @@ TEST(PipelinePresetTest, WithoutAnImuTheVideoGivesTheRotation) {
         if (visual) po.rotation_source = RotationSource::kVisual;
         std::unique_ptr<eval::Scorecard> card;
         ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
-        ASSERT_TRUE(eval::RunMethod(*s, method, po, false, card.get(), nullptr).ok());
+        ASSERT_TRUE(eval::RunMethod(*s, method, po, card.get()).ok());
         by[visual][k] = card->Compute();
       }
     }
@@ -296,9 +299,9 @@ TEST(PipelinePresetTest, TheVideosFirstFrameIsWithheldAndTheStartDoesNotJump) {
     std::unique_ptr<eval::Scorecard> card;
     ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
     std::vector<StabilizerFrame> frames;
-    ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadifaceLayered, po, false, card.get(),
-                                &frames)
-                    .ok());
+    eval::RunMethodOptions run;
+    run.frames = &frames;
+    ASSERT_TRUE(eval::RunMethod(*s, eval::Method::kSteadifaceLayered, po, card.get(), run).ok());
     EXPECT_EQ(frames.size() + 1, static_cast<size_t>(s->num_frames()));
     const eval::Score sc = card->Compute();
     std::cout << "[ " << preset << ", rotation from the video, layered ] largest step of the "
@@ -347,7 +350,7 @@ TEST(PipelinePresetTest, ANearSecondFaceDoesNotTurnTheVideosRotation) {
     if (video) po.rotation_source = RotationSource::kVisual;
     std::unique_ptr<eval::Scorecard> card;
     ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
-    ASSERT_TRUE(eval::RunMethod(*s, method, po, false, card.get(), nullptr).ok());
+    ASSERT_TRUE(eval::RunMethod(*s, method, po, card.get()).ok());
     (video ? layered_video : gyro_imu) = card->Compute();
   }
   std::cout << "[ two_faces ] visible background: layered with the video "
@@ -445,7 +448,7 @@ eval::Score RunHorizon(const sim::Simulator& s, HorizonMode mode, double level_t
   po.horizon.level_tolerance_deg = level_tolerance_deg;
   std::unique_ptr<eval::Scorecard> card;
   EXPECT_TRUE(eval::MakeScorecard(s, po, &card).ok());
-  const Status st = eval::RunMethod(s, eval::Method::kGyroOnly, po, false, card.get(), nullptr);
+  const Status st = eval::RunMethod(s, eval::Method::kGyroOnly, po, card.get());
   EXPECT_TRUE(st.ok()) << st.message();
   return card->Compute();
 }

@@ -25,7 +25,9 @@ inline eval::Score ScoreRun(const sim::Simulator& s, eval::Method method,
   if (tweak) tweak(&po);
   std::unique_ptr<eval::Scorecard> card;
   Status st = eval::MakeScorecard(s, po, &card);
-  if (st.ok()) st = eval::RunMethod(s, method, po, false, card.get(), frames);
+  eval::RunMethodOptions run;
+  run.frames = frames;
+  if (st.ok()) st = eval::RunMethod(s, method, po, card.get(), run);
   EXPECT_TRUE(st.ok()) << st.message();
   return st.ok() ? card->Compute() : eval::Score();
 }

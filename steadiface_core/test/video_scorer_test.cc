@@ -114,8 +114,10 @@ TEST(VideoScorerTest, AgreesWithTheExactScorecardOnARenderedPreset) {
     ASSERT_TRUE(eval::MakeScorecard(*s, po, &card).ok());
     std::unique_ptr<eval::VideoScorer> v;
     ASSERT_TRUE(eval::VideoScorer::Create(s->intrinsics(), eval::VideoScorerOptions(), &v).ok());
-    const Status st = eval::RunMethod(*s, m, po, true, card.get(), nullptr,
-                                      [&v](const cv::Mat& f) { return v->Add(f); });
+    eval::RunMethodOptions run;
+    run.render = true;
+    run.on_output = [&v](const cv::Mat& f) { return v->Add(f); };
+    const Status st = eval::RunMethod(*s, m, po, card.get(), run);
     ASSERT_TRUE(st.ok()) << st.message();
     const eval::Score exact = card->Compute(), approx = v->Compute();
     std::cout << "[ " << eval::MethodName(m) << " ] head exact " << exact.head_jitter_px

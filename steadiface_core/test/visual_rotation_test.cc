@@ -426,7 +426,7 @@ TEST(VisualRotationTest, AnImuDropoutIsBridgedAndHandedBackWithoutAJump) {
     std::unique_ptr<eval::Scorecard> card;
     EXPECT_TRUE(eval::MakeScorecard(*s, po, &card, Eigen::Vector2d(1.0, 2.0)).ok());
     const Status st =
-        eval::RunMethod(*s, eval::Method::kSteadifaceLayered, po, false, card.get(), nullptr);
+        eval::RunMethod(*s, eval::Method::kSteadifaceLayered, po, card.get());
     EXPECT_TRUE(st.ok()) << st.message();
     return card->Compute();
   };

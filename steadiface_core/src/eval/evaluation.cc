@@ -262,10 +262,14 @@ Status PresetRun::RunPipeline(const std::string& name, Method m, bool video, Vid
   const bool composite = m == Method::kSteadifaceComposite && !video;
   std::vector<StabilizerFrame> frames;
   CompositeQualityScore cq;
-  s = RunMethod(*sim_, m, po, o_.render || video || ap != nullptr, card.get(), &frames, sink,
-                composite ? &cq : nullptr,
-                o_.composite_frames ? o_.out_dir + "/composite_" + preset_ : std::string(),
-                o_.true_head);
+  RunMethodOptions ro;
+  ro.render = o_.render || video || ap != nullptr;
+  ro.frames = &frames;
+  ro.on_output = sink;
+  ro.composite_quality = composite ? &cq : nullptr;
+  if (o_.composite_frames) ro.composite_frames = o_.out_dir + "/composite_" + preset_;
+  ro.true_head = o_.true_head;
+  s = RunMethod(*sim_, m, po, card.get(), ro);
   if (!s.ok()) return s;
   if (composite) composite_rows->push_back(CompositeRow(preset_, cq));
   if (video) return Status::Ok();

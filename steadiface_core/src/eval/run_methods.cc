@@ -123,10 +123,9 @@ void FeedGyroForFrame(const sim::Simulator& sim, Time stamp, double imu_time_off
 }
 
 Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions& options,
-                 bool render, Scorecard* card, std::vector<StabilizerFrame>* frames_out,
-                 const std::function<Status(const cv::Mat&)>& on_output,
-                 CompositeQualityScore* composite_quality, const std::string& composite_frames,
-                 bool true_head) {
+                 Scorecard* card, const RunMethodOptions& run) {
+  const bool render = run.render;
+  const auto& on_output = run.on_output;
   if (method == Method::kNone) {
     cv::Mat frame;
     sim::SimTruth truth;
@@ -147,13 +146,11 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
   Status s = Pipeline::Create(sim.intrinsics(), o, &p);
   if (!s.ok()) return s;
   std::unique_ptr<CompositeQuality> quality;
-  if (composite && composite_quality != nullptr) {
+  if (composite && run.composite_quality != nullptr) {
     s = CompositeQuality::Create(sim, *p, &quality);
     if (!s.ok()) return s;
     p->KeepCompositePlateUse(true);
-    if (!composite_frames.empty()) {
-      quality->DumpFrames(composite_frames, 15);
-    }
+    if (!run.composite_frames.empty()) quality->DumpFrames(run.composite_frames, 15);
   }
   size_t g = 0;
   cv::Mat frame;
@@ -173,7 +170,7 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
       frame = cv::Mat(sim.intrinsics().height, sim.intrinsics().width, CV_8UC1,
                       cv::Scalar(0));
     }
-    if (true_head) {
+    if (run.true_head) {
       const sim::SimTruth t = sim.Truth(i);
       if (t.head_in_view) p->SetTrueHeadCentre(t.head_px);
     }
@@ -190,9 +187,9 @@ Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions
       s = on_output(out.output);
       if (!s.ok()) return s;
     }
-    if (frames_out != nullptr) frames_out->push_back(out.stabilizer);
+    if (run.frames != nullptr) run.frames->push_back(out.stabilizer);
   }
-  if (quality != nullptr) *composite_quality = quality->Compute();
+  if (quality != nullptr) *run.composite_quality = quality->Compute();
   return Status::Ok();
 }
 

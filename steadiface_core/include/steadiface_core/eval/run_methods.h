@@ -61,23 +61,32 @@ inline bool ImuHasGap(const sim::SimulatorOptions& o) {
   return o.imu_dropout_start_s >= 0.0 && o.imu_dropout_end_s > o.imu_dropout_start_s;
 }
 
-/// Renders every frame, feeds the IMU and the frames through a Pipeline
-/// (render_output off unless `render`), and scores the warps. Fills
-/// `score` and `card` (for trajectories); `frames_out` (optional) receives
-/// the stabilizer frames; `on_output` (optional, needs `render`) receives
-/// each output image (for kNone: the input frame). The composite always
-/// renders (its matte and plate are made from the pictures) and, with
-/// `composite_quality`, is scored against the truth (CompositeQuality);
-/// `composite_frames`, a path prefix, also writes every 15th frame's
-/// picture (CompositeQuality::DumpFrames). `true_head`: the stabilizer is
-/// handed the true head centre (Pipeline::SetTrueHeadCentre) on every frame
-/// the head is in view.
-Status RunMethod(const sim::Simulator& sim, Method method,
-                 const PipelineOptions& options, bool render,
-                 Scorecard* card, std::vector<StabilizerFrame>* frames_out,
-                 const std::function<Status(const cv::Mat&)>& on_output = nullptr,
-                 CompositeQualityScore* composite_quality = nullptr,
-                 const std::string& composite_frames = std::string(), bool true_head = false);
+/// What RunMethod renders and hands back besides the scorecard.
+struct RunMethodOptions {
+  /// Render every output image (Pipeline's render_output; the composite
+  /// always renders, as its matte and plate are made from the pictures).
+  bool render = false;
+  /// Receives the stabilizer frames, if set.
+  std::vector<StabilizerFrame>* frames = nullptr;
+  /// Receives each output image (for kNone: the input frame), if set; needs
+  /// `render`.
+  std::function<Status(const cv::Mat&)> on_output;
+  /// The composite's matte and plate scored against the truth
+  /// (CompositeQuality), if set.
+  CompositeQualityScore* composite_quality = nullptr;
+  /// A path prefix: with composite_quality, also writes every 15th frame's
+  /// picture (CompositeQuality::DumpFrames). Empty: none.
+  std::string composite_frames;
+  /// The stabilizer is handed the true head centre
+  /// (Pipeline::SetTrueHeadCentre) on every frame the head is in view.
+  bool true_head = false;
+};
+
+/// Renders every frame, feeds the IMU and the frames through a Pipeline,
+/// and scores the warps into `card` (also kept for trajectories); `run`
+/// says what else is rendered and handed back.
+Status RunMethod(const sim::Simulator& sim, Method method, const PipelineOptions& options,
+                 Scorecard* card, const RunMethodOptions& run = RunMethodOptions());
 
 }  // namespace eval
 }  // namespace steadiface
