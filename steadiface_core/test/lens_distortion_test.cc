@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
+#include "steadiface_core/camera/camera_model.h"
+
 namespace steadiface {
 namespace {
 
@@ -59,6 +61,24 @@ TEST(LensDistortionTest, MatchesOpenCvAndInvertsForEveryModel) {
       Eigen::Vector2d back;
       ASSERT_TRUE(UndistortCameraPoint(k, d, &back)) << m.transpose();
       EXPECT_LT((back - m).norm(), 1e-9) << m.transpose();
+    }
+  }
+}
+
+// A pixel as the lens recorded it (OpenCV's projection) is normalized where
+// its undistorted pixel is (CameraModel::RawPixelToNormalized); without a
+// lens model the raw pixel is the ideal one.
+TEST(LensDistortionTest, ARawPixelIsNormalizedWhereItsIdealPixelIs) {
+  for (const CameraIntrinsics& k : {Lens(DistortionModel::kPlumbBob, {-0.28, 0.09, 0.001, -0.0005, -0.01}),
+                                    Lens(DistortionModel::kNone, {})}) {
+    CameraModel model;
+    ASSERT_TRUE(CameraModel::Create(k, CameraModelOptions(), &model).ok());
+    for (const Eigen::Vector2d& m : Grid()) {
+      const cv::Point2d raw = OpenCvPixel(k, m);
+      const Eigen::Vector2d ideal(k.fx * m.x() + k.cx, k.fy * m.y() + k.cy);
+      Eigen::Vector2d n;
+      ASSERT_TRUE(model.RawPixelToNormalized(Eigen::Vector2d(raw.x, raw.y), &n)) << m.transpose();
+      EXPECT_LT((n - model.PixelToNormalized(ideal)).norm(), 1e-9) << m.transpose();
     }
   }
 }

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "steadiface_core/camera/lens_distortion.h"
+
 namespace steadiface {
 
 Status ValidateCameraModelOptions(const CameraModelOptions& options) {
@@ -35,6 +37,14 @@ Eigen::Vector2d CameraModel::PixelToNormalized(
   const double w = intrinsics_.width;
   return Eigen::Vector2d((pixel.x() - intrinsics_.cx) / w + 0.5,
                          (pixel.y() - intrinsics_.cy) * y_scale_ / w + 0.5);
+}
+
+bool CameraModel::RawPixelToNormalized(const Eigen::Vector2d& raw,
+                                       Eigen::Vector2d* normalized) const {
+  Eigen::Vector2d ideal = raw;
+  const bool ok = UndistortPixel(intrinsics_, raw, &ideal);
+  *normalized = PixelToNormalized(ideal);
+  return ok;
 }
 
 Eigen::Vector2d CameraModel::NormalizedToPixel(

@@ -7,7 +7,6 @@
 #include <cmath>
 
 #include "face/landmark_shape.h"
-#include "steadiface_core/camera/lens_distortion.h"
 #include "steadiface_core/face/head_pose.h"
 #include "steadiface_core/face/landmarks68.h"
 
@@ -26,11 +25,8 @@ cv::Rect2d FaceTracker::BoxFromLandmarks(const std::vector<Eigen::Vector2d>& lm)
 void FaceTracker::Fill(const std::vector<Eigen::Vector2d>& lm, FaceInfo* info) const {
   info->landmarks_px = lm;
   info->landmarks_normalized.resize(lm.size());
-  const CameraIntrinsics& k = model_.intrinsics();
   for (size_t i = 0; i < lm.size(); ++i) {
-    Eigen::Vector2d ideal = lm[i];
-    if (k.HasDistortion()) UndistortPixel(k, lm[i], &ideal);
-    info->landmarks_normalized[i] = model_.PixelToNormalized(ideal);
+    model_.RawPixelToNormalized(lm[i], &info->landmarks_normalized[i]);
   }
   info->centre_px = Mean(lm);
   info->scale_px = RmsRadius(lm, info->centre_px);

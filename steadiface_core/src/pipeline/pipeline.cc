@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 
-#include "steadiface_core/camera/lens_distortion.h"
 #include "steadiface_core/common/grey.h"
 #include "steadiface_core/common/stopwatch.h"
 #include "steadiface_core/view/crop_need.h"
@@ -452,10 +451,10 @@ Status Pipeline::Passthrough(const cv::Mat& image, PipelineFrame* out) {
 
 void Pipeline::SetTrueHeadCentre(const Eigen::Vector2d& pixel) {
   // As the tracker's landmarks are: undistorted, then normalized.
-  Eigen::Vector2d ideal = pixel;
-  const CameraIntrinsics& k = model_.intrinsics();
-  if (k.HasDistortion() && !UndistortPixel(k, pixel, &ideal)) return;
-  stabilizer_->SetTrueHeadCentre(model_.PixelToNormalized(ideal));
+  Eigen::Vector2d normalized;
+  if (model_.RawPixelToNormalized(pixel, &normalized)) {
+    stabilizer_->SetTrueHeadCentre(normalized);
+  }
 }
 
 Status Pipeline::UpdateStabilizerOptions(const StabilizerOptions& options) {

@@ -9,7 +9,6 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "steadiface_core/camera/lens_distortion.h"
 #include "steadiface_core/common/stopwatch.h"
 #include "visual/rotation_fit.h"
 
@@ -165,11 +164,10 @@ namespace {
 // A copy pixel to the camera ray (X/Z, Y/Z) through it.
 Eigen::Vector2d Ray(const CameraModel& model, double scale,
                     const cv::Point2f& p) {
-  Eigen::Vector2d px((p.x + 0.5) / scale - 0.5, (p.y + 0.5) / scale - 0.5);
-  const CameraIntrinsics& k = model.intrinsics();
-  if (k.HasDistortion()) UndistortPixel(k, px, &px);
-  return (model.PixelToNormalized(px) - Eigen::Vector2d(0.5, 0.5)) /
-         model.real_focal();
+  const Eigen::Vector2d px((p.x + 0.5) / scale - 0.5, (p.y + 0.5) / scale - 0.5);
+  Eigen::Vector2d n;
+  model.RawPixelToNormalized(px, &n);
+  return (n - Eigen::Vector2d(0.5, 0.5)) / model.real_focal();
 }
 
 }  // namespace

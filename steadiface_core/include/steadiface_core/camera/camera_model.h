@@ -62,6 +62,11 @@ class CameraModel {
 
   /// Real (distortion-free) pixel -> normalized coordinates.
   Eigen::Vector2d PixelToNormalized(const Eigen::Vector2d& pixel) const;
+  /// Raw pixel as the camera recorded it -> normalized coordinates: the lens
+  /// distortion removed (UndistortPixel), then PixelToNormalized. Returns
+  /// false where the undistortion does not converge; `*normalized` is then
+  /// the raw pixel's.
+  bool RawPixelToNormalized(const Eigen::Vector2d& raw, Eigen::Vector2d* normalized) const;
   /// Normalized coordinates -> real pixel.
   Eigen::Vector2d NormalizedToPixel(const Eigen::Vector2d& normalized) const;
 
