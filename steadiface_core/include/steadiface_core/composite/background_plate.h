@@ -93,9 +93,6 @@ class BackgroundPlate {
   double now() const { return now_; }
   /// Last time each pixel was seen [s]; -inf where never.
   const cv::Mat& seen() const { return seen_; }
-  /// Frames that agreed with each pixel since it was last replaced (CV_8U,
-  /// saturating).
-  const cv::Mat& agreed() const { return agreed_; }
 
  private:
   // Plate pixel <- output pixel of the current view.
@@ -115,7 +112,7 @@ class BackgroundPlate {
   const int margin_x_, margin_y_;
   cv::Mat plate_;  // CV_8UC3
   cv::Mat seen_;   // CV_32F
-  cv::Mat agreed_;  // CV_8U
+  cv::Mat agreed_;  // CV_8U: frames that agreed since the pixel was last replaced (saturating)
   bool anchored_ = false;
   LayerView anchor_, view_;
   Eigen::Matrix3d view_to_plate_ = Eigen::Matrix3d::Identity();
