@@ -112,7 +112,9 @@ class BackgroundPlate {
   const int margin_x_, margin_y_;
   cv::Mat plate_;  // CV_8UC3
   cv::Mat seen_;   // CV_32F
-  cv::Mat agreed_;  // CV_8U: frames that agreed since the pixel was last replaced (saturating)
+  // CV_8U: frames that agreed with each pixel since it was last replaced
+  // (saturating).
+  cv::Mat agreed_;
   bool anchored_ = false;
   LayerView anchor_, view_;
   Eigen::Matrix3d view_to_plate_ = Eigen::Matrix3d::Identity();
