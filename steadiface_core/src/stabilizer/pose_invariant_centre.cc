@@ -15,6 +15,9 @@ constexpr double kSpeedCutoffHz = 1.0;
 // A first-order low-pass's gain for a step of `dt` at cut-off `hz`.
 double Gain(double dt, double hz) { return 1.0 - std::exp(-2.0 * M_PI * hz * dt); }
 
+// The same for time constant `tau` [s]; 1 (no smoothing) where tau <= 0.
+double DecayGain(double dt, double tau) { return tau > 0.0 ? 1.0 - std::exp(-dt / tau) : 1.0; }
+
 }  // namespace
 
 void PoseInvariantCentre::FilterYaw(double yaw, double dt) {
@@ -41,9 +44,8 @@ double PoseInvariantCentre::FilterNod(double pitch, double dt) {
     return 0.0;
   }
   const double h = std::min(dt, 1.0);
-  const double tau = options_.pose_yaw_time_constant_s;
-  pitch_ += (tau > 0.0 ? 1.0 - std::exp(-h / tau) : 1.0) * (pitch - pitch_);
-  pitch_mean_ += (1.0 - std::exp(-h / options_.pose_nod_time_constant_s)) * (pitch - pitch_mean_);
+  pitch_ += DecayGain(h, options_.pose_yaw_time_constant_s) * (pitch - pitch_);
+  pitch_mean_ += DecayGain(h, options_.pose_nod_time_constant_s) * (pitch - pitch_mean_);
   return pitch_ - pitch_mean_;
 }
 
