@@ -46,6 +46,7 @@ Status Compositor::Create(const OutputGeometry& output, const CompositeOptions& 
 void Compositor::Reset() {
   matte_.Reset();
   plate_.Reset();
+  past_rois_.clear();
   report_ = CompositeReport();
 }
 
@@ -91,7 +92,8 @@ Status Compositor::Compose(const cv::Mat& subject, const LayerView& subject_view
   report_.matte_ms = MsSince(t0);
   if (!active.empty()) ComposeActive(subject, subject_view, background_view, region, active, raw, out);
   t0 = std::chrono::steady_clock::now();
-  UpdatePlate(background, roi, active, raw);
+  report_.plate_learnt = LearnRect(background_view, roi, time_s);
+  UpdatePlate(background, report_.plate_learnt, active, raw);
   report_.plate_ms += MsSince(t0);
   report_.plate_coverage = plate_.Coverage();
   report_.plate_restarts = plate_.restarts();
@@ -126,33 +128,51 @@ void Compositor::ComposeActive(const cv::Mat& subject, const LayerView& subject_
   report_.blend_ms = MsSince(t0);
 }
 
-void Compositor::UpdatePlate(const cv::Mat& background, const cv::Rect& roi, const cv::Rect& active,
-                             const cv::Mat& raw) {
+cv::Rect Compositor::LearnRect(const LayerView& view, const cv::Rect& roi, double time_s) {
+  const double max_age = options_.plate.max_age_s;
+  while (!past_rois_.empty() &&
+         (past_rois_.size() >= kMaxRois || !(time_s - past_rois_.front().time_s < max_age) ||
+          past_rois_.back().time_s > time_s)) {
+    past_rois_.pop_front();
+  }
+  past_rois_.push_back({time_s, view, roi});
+  const cv::Rect whole(0, 0, output_.width(), output_.height());
+  cv::Rect learn = roi;
+  for (const PastRoi& p : past_rois_) learn |= MapRect(HomographyBetween(view, p.view), p.roi, whole);
+  return learn & whole;
+}
+
+void Compositor::UpdatePlate(const cv::Mat& background, const cv::Rect& learn,
+                             const cv::Rect& active, const cv::Mat& raw) {
   // The plate learns this frame's scene around the subject (what it may
-  // uncover next), where the matte knows the scene to be and away from the
-  // subject's edge.
+  // uncover next): over the matte's low roi where the matte knows the scene
+  // to be, beyond it everywhere (beyond the matte's search, the scene), and
+  // away from the subject's edge.
   const int s = matte_.scale();
   const cv::Rect& rl = matte_.low_roi();
   const cv::Rect view_rl(rl.x * s, rl.y * s, rl.width * s, rl.height * s);
-  const cv::Rect update = view_rl & roi;
+  const cv::Rect update = learn & cv::Rect(0, 0, background.cols, background.rows);
   if (update.empty() || matte_.scene_known_low().empty()) return;
   // Blocked (255) where the scene is not known, in 1/255 steps like the
   // matte, and within plate_distance_px of the subject.
-  cv::Mat unknown;
-  matte_.scene_known_low().convertTo(unknown, CV_8U, -255.0, 255.0);
-  cv::resize(unknown, blocked_, view_rl.size(), 0, 0, cv::INTER_NEAREST);
-  cv::Mat blocked = blocked_(cv::Rect(update.x - view_rl.x, update.y - view_rl.y, update.width,
-                                      update.height));
-  if (!active.empty()) {
+  blocked_.create(update.size(), CV_8U);
+  blocked_.setTo(cv::Scalar(0));
+  const cv::Rect known = view_rl & update;
+  if (!known.empty()) {
+    matte_.scene_known_low().convertTo(unknown_, CV_8U, -255.0, 255.0);
+    cv::resize(unknown_, unknown_up_, view_rl.size(), 0, 0, cv::INTER_NEAREST);
+    unknown_up_(known - view_rl.tl()).copyTo(blocked_(known - update.tl()));
+  }
+  const cv::Rect a = active & update;
+  if (!a.empty()) {
     const int g = 2 * options_.plate_distance_px + 1;
     cv::Mat raw8;
     raw.convertTo(raw8, CV_8U, 255.0);
     cv::dilate(raw8, raw8, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(g, g)));
-    const cv::Rect a = active & update;
-    cv::Mat b = blocked(cv::Rect(a.x - update.x, a.y - update.y, a.width, a.height));
-    cv::max(b, raw8(cv::Rect(a.x - active.x, a.y - active.y, a.width, a.height)), b);
+    cv::Mat b = blocked_(a - update.tl());
+    cv::max(b, raw8(a - active.tl()), b);
   }
-  plate_.Update(background(update), blocked, update, static_cast<float>(options_.plate_below),
+  plate_.Update(background(update), blocked_, update, static_cast<float>(options_.plate_below),
                 options_.plate_row_step, frame_++);
 }
 

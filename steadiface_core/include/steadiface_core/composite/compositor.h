@@ -1,5 +1,6 @@
 #pragma once
 
+#include <deque>
 #include <memory>
 
 #include <Eigen/Core>
@@ -52,6 +53,10 @@ struct CompositeReport {
   double plate_coverage = 0.0;
   int plate_restarts = 0;
   int plate_reprojections = 0;
+  /// The rectangle the plate learnt this frame: the matte's roi and where
+  /// it was over the plate's lifetime, in this frame's background view
+  /// [output px].
+  cv::Rect plate_learnt;
   /// Mean matte over the background roi [0-1].
   double matte_mean = 0.0;
   double matte_ms = 0.0, plate_ms = 0.0, blend_ms = 0.0;
@@ -104,12 +109,17 @@ class Compositor {
   Compositor(const OutputGeometry& output, const CompositeOptions& options);
   // Compose's pieces: the subject's matte in both views, the plate's fill and
   // the blend over the active rectangle (where the matte is); the plate's
-  // update over the matte's roi.
+  // update over LearnRect.
   void ComposeActive(const cv::Mat& subject, const LayerView& subject_view,
                      const LayerView& background_view, const SubjectRegion& region,
                      const cv::Rect& active, const cv::Mat& raw, cv::Mat* out);
-  void UpdatePlate(const cv::Mat& background, const cv::Rect& roi, const cv::Rect& active,
+  void UpdatePlate(const cv::Mat& background, const cv::Rect& learn, const cv::Rect& active,
                    const cv::Mat& raw);
+  // Where the plate learns this frame: `roi` and the rois of the frames
+  // within the plate's lifetime, each moved into `view` (what the subject
+  // uncovers lies where it has been, and a roi's rows above or beside this
+  // frame's are otherwise never learnt).
+  cv::Rect LearnRect(const LayerView& view, const cv::Rect& roi, double time_s);
   // Fills the subject's uncovered pixels of `out` (over the background roi).
   void FillUncovered(const cv::Mat& subject, cv::Mat* out);
   // FillUncovered's row y of the background roi (rows may run in
@@ -126,7 +136,17 @@ class Compositor {
   CompositeReport report_;
   cv::Mat matte_b_, plate_weight_, plate_sample_;
   cv::Mat matte_b8_, matte_s_;  // the matte in 1/255 steps in both views
-  cv::Mat blocked_;             // UpdatePlate's scratch (kept: no allocation per frame)
+  // UpdatePlate's scratch (kept: no allocation per frame).
+  cv::Mat blocked_, unknown_, unknown_up_;
+  // The recent frames' matte rois in their background views (bounded by
+  // the plate's lifetime and kMaxRois).
+  struct PastRoi {
+    double time_s;
+    LayerView view;
+    cv::Rect roi;
+  };
+  static constexpr size_t kMaxRois = 256;
+  std::deque<PastRoi> past_rois_;
   bool keep_plate_ = false;
   int frame_ = 0;  // frames composed (the plate's row phase)
 };
