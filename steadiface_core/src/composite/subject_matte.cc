@@ -53,6 +53,9 @@ Status ValidateSubjectMatteOptions(const SubjectMatteOptions& o) {
   if (!In(o.plate_confidence, 0.0, 8.0)) {
     return Status::Error("composite.matte: plate_confidence must be in [0, 8]");
   }
+  if (o.absent_frames < 0 || o.absent_frames > 255) {
+    return Status::Error("composite.matte: absent_frames must be in [0, 255]");
+  }
   if (!In(o.motion_memory, 0.0, 0.99)) {
     return Status::Error("composite.matte: motion_memory must be in [0, 0.99]");
   }
@@ -84,6 +87,7 @@ SubjectMatte::SubjectMatte(const SubjectMatteOptions& options)
 void SubjectMatte::Reset() {
   has_previous_ = false;
   accumulated_.release();
+  absent_.release();
   std::fill(subject_hist_.begin(), subject_hist_.end(), 0.0f);
   std::fill(scene_hist_.begin(), scene_hist_.end(), 0.0f);
 }
@@ -126,6 +130,7 @@ void SubjectMatte::Estimate(const MatteInputs& in, cv::Rect* active, cv::Mat* ma
   const cv::Mat lm = MotionEvidence(in, low);
   const cv::Mat accumulated = AccumulateMotion(in, low, lm);
   Evidence(in, low, lm, accumulated, &logodds, &verified);
+  VerifyLongAbsent(in, low, logodds, &verified);
   Refine(in, low, logodds, active, matte);
   scene_known_low_ = verified;
   low_roi_ = low.roi;
@@ -372,6 +377,49 @@ void SubjectMatte::Evidence(const MatteInputs& in, const LowRes& low, const cv::
       }
     }
   });
+}
+
+void SubjectMatte::VerifyLongAbsent(const MatteInputs& in, const LowRes& low,
+                                    const cv::Mat& logodds, cv::Mat* verified) {
+  // The subject stands still in the subject layer's view. There, a spot the
+  // matte has not put the subject on for absent_frames frames in a row is
+  // the scene, even where nothing textured moved to prove it. Present: the
+  // matte above 0.018 (log-odds -4), grown by a low pixel; absent: below,
+  // and beyond the roi; unknown (128): outside this frame's view.
+  if (options_.absent_frames <= 0) return;
+  const int s = low.s;
+  const cv::Rect& rl = low.roi;
+  const cv::Size small = low.subject.size();
+  const cv::Rect whole(0, 0, in.background.cols, in.background.rows);
+  const cv::Rect view_rl(rl.x * s, rl.y * s, rl.width * s, rl.height * s);
+  cv::Mat present = cv::Mat::zeros(small, CV_8U);
+  present(rl).setTo(cv::Scalar(255), logodds > -4.0f);
+  cv::dilate(present, present, cv::Mat());
+  cv::Mat moved;
+  cv::warpPerspective(present, moved,
+                      RectMap(HomographyBetween(in.background_view, in.subject_view), whole,
+                              1.0 / s, whole, 1.0 / s),
+                      small, cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                      cv::Scalar(128));
+  if (absent_.size() != small) absent_ = cv::Mat::zeros(small, CV_8U);
+  for (int y = 0; y < small.height; ++y) {
+    const uchar* m = moved.ptr<uchar>(y);
+    uchar* a = absent_.ptr<uchar>(y);
+    for (int x = 0; x < small.width; ++x) {
+      if (m[x] == 255) {
+        a[x] = 0;
+      } else if (m[x] == 0 && a[x] < 255) {
+        ++a[x];
+      }
+    }
+  }
+  cv::Mat back;
+  cv::warpPerspective(absent_, back,
+                      RectMap(HomographyBetween(in.subject_view, in.background_view), whole,
+                              1.0 / s, view_rl, 1.0 / s),
+                      rl.size(), cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                      cv::Scalar(0));
+  verified->setTo(cv::Scalar(1.0f), back >= options_.absent_frames);
 }
 
 float SubjectMatte::ColourLogRatio(const uchar* px, int cn) const {

@@ -39,6 +39,11 @@ struct SubjectMatteOptions {
   /// are below minus this even where nothing moved (plain walls; elsewhere
   /// it needs the motion evidence) [-].
   double plate_confidence = 4.0;
+  /// The plate also takes a pixel whose spot in the subject layer's view
+  /// (where the subject stands still) the matte has held below 0.018 for
+  /// this many frames in a row: the scene, textured or plain (0: off)
+  /// [frames].
+  int absent_frames = 8;
   /// Weight of the online colour model's log-likelihood ratio [-].
   double colour_weight = 0.7;
   /// Weight of the previous frame's log-odds, moved with the subject [-].
@@ -94,8 +99,9 @@ class SubjectMatte {
   void Estimate(const MatteInputs& in, cv::Rect* active, cv::Mat* matte);
   /// Where the last Estimate knew the scene to be (CV_32F, 1 or 0, at low
   /// resolution over low_roi()): beyond the search, seen standing still in
-  /// the background layer while moving in the subject layer, or confidently
-  /// the scene outside the landmarks' region. Only there may the plate learn.
+  /// the background layer while moving in the subject layer, confidently
+  /// the scene outside the landmarks' region, or where the subject has long
+  /// been absent in its own layer's view. Only there may the plate learn.
   const cv::Mat& scene_known_low() const { return scene_known_low_; }
   const cv::Rect& low_roi() const { return low_roi_; }
 
@@ -108,6 +114,11 @@ class SubjectMatte {
   cv::Mat AccumulateMotion(const MatteInputs& in, const LowRes& low, const cv::Mat& lm);
   void Evidence(const MatteInputs& in, const LowRes& low, const cv::Mat& lm,
                 const cv::Mat& accumulated, cv::Mat* logodds, cv::Mat* verified) const;
+  // Counts, in the subject layer's view, the frames each spot has been
+  // without the subject, and adds to *verified the pixels whose spot has
+  // been so for absent_frames.
+  void VerifyLongAbsent(const MatteInputs& in, const LowRes& low, const cv::Mat& logodds,
+                        cv::Mat* verified);
   // The log-odds into the refined full-resolution matte over *active.
   void Refine(const MatteInputs& in, const LowRes& low, const cv::Mat& logodds, cv::Rect* active,
               cv::Mat* matte) const;
@@ -133,6 +144,7 @@ class SubjectMatte {
   cv::Mat scene_known_low_;
   cv::Rect low_roi_;
   cv::Mat accumulated_;  // motion evidence, subject layer's view, low resolution
+  cv::Mat absent_;       // frames without the subject (CV_8U), the same
 };
 
 }  // namespace steadiface
