@@ -130,9 +130,9 @@ void Compositor::ComposeActive(const cv::Mat& subject, const LayerView& subject_
 
 cv::Rect Compositor::LearnRect(const LayerView& view, const cv::Rect& roi, double time_s) {
   const double max_age = options_.plate.max_age_s;
+  if (!past_rois_.empty() && past_rois_.back().time_s > time_s) past_rois_.clear();  // time went back
   while (!past_rois_.empty() &&
-         (past_rois_.size() >= kMaxRois || !(time_s - past_rois_.front().time_s < max_age) ||
-          past_rois_.back().time_s > time_s)) {
+         (past_rois_.size() >= kMaxRois || !(time_s - past_rois_.front().time_s < max_age))) {
     past_rois_.pop_front();
   }
   past_rois_.push_back({time_s, view, roi});

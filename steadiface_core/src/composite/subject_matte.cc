@@ -73,6 +73,8 @@ Status ValidateSubjectMatteOptions(const SubjectMatteOptions& o) {
 struct SubjectMatte::LowRes {
   int s = 1;
   cv::Rect roi;              // low-resolution pixels
+  // roi in output pixels (its low pixels' full extent).
+  cv::Rect ViewRoi() const { return cv::Rect(roi.x * s, roi.y * s, roi.width * s, roi.height * s); }
   cv::Mat background;        // whole output, grey, low resolution
   cv::Mat subject;           // whole output, grey, low resolution
   cv::Mat colour;            // the background layer over roi, low resolution
@@ -255,7 +257,7 @@ cv::Mat SubjectMatte::MotionEvidence(const MatteInputs& in, const LowRes& low) c
   cv::Mat lm(rl.size(), CV_32F, cv::Scalar(NAN));
   if (!has_previous_) return lm;
   const cv::Rect whole(0, 0, in.background.cols, in.background.rows);
-  const cv::Rect view_rl(rl.x * s, rl.y * s, rl.width * s, rl.height * s);
+  const cv::Rect view_rl = low.ViewRoi();
   const cv::Matx33d Mb = RectMap(HomographyBetween(previous_view_, in.background_view), whole,
                                  1.0 / s, view_rl, 1.0 / s);
   cv::Mat prev_bg, moved_bg, subject_change, moved_subject;
@@ -291,7 +293,7 @@ cv::Mat SubjectMatte::AccumulateMotion(const MatteInputs& in, const LowRes& low,
   const cv::Rect& rl = low.roi;
   const cv::Size small = low.subject.size();
   const cv::Rect whole(0, 0, in.background.cols, in.background.rows);
-  const cv::Rect view_rl(rl.x * s, rl.y * s, rl.width * s, rl.height * s);
+  const cv::Rect view_rl = low.ViewRoi();
   if (accumulated_.size() != small) accumulated_ = cv::Mat::zeros(small, CV_32F);
   accumulated_ *= options_.motion_memory;
   cv::Mat moved;
@@ -391,7 +393,7 @@ void SubjectMatte::VerifyLongAbsent(const MatteInputs& in, const LowRes& low,
   const cv::Rect& rl = low.roi;
   const cv::Size small = low.subject.size();
   const cv::Rect whole(0, 0, in.background.cols, in.background.rows);
-  const cv::Rect view_rl(rl.x * s, rl.y * s, rl.width * s, rl.height * s);
+  const cv::Rect view_rl = low.ViewRoi();
   cv::Mat present = cv::Mat::zeros(small, CV_8U);
   present(rl).setTo(cv::Scalar(255), logodds > -4.0f);
   cv::dilate(present, present, cv::Mat());
