@@ -276,15 +276,60 @@ TEST(TurningHeadTest, AHeadWhippingRoundIsHeldNotFollowedAsCovered) {
   std::cout << "[ turn_away, +-57 deg at 0.33 Hz ] head px: gyro-only " << gyro.head_jitter_px
             << ", every loss followed as covered " << any_loss.head_jitter_px
             << ", a faded face held " << ours.head_jitter_px << "\n";
-  // Measured (seed 1): 7.25, 22.74, 8.14 px.
+  // Measured (seed 1): 7.25, 15.85, 8.41 px (22.93 every loss followed as
+  // covered while a covered face's yaw was reported as 0, not held).
   EXPECT_GT(any_loss.head_jitter_px, 2.0 * gyro.head_jitter_px);
   EXPECT_LT(ours.head_jitter_px, 1.25 * gyro.head_jitter_px);
-  EXPECT_LT(ours.head_jitter_px, 0.5 * any_loss.head_jitter_px);
+  EXPECT_LT(ours.head_jitter_px, 0.6 * any_loss.head_jitter_px);
   EXPECT_EQ(ours.undefined_fraction, 0.0);
   // Out of range is refused.
   PipelineOptions bad;
   bad.face.follow_covered_min_appearance = 1.5;
   EXPECT_FALSE(ValidateFaceTrackerOptions(bad.face).ok());
+}
+
+// occlusion with three times the head's motion: the head turns by up to
+// 0.3 rad as the hand covers it. A covered face is followed by its visible
+// parts' translation, which does not show its turn; its pose is held at
+// the last fits' (their median: the last one is already dragged by the
+// hand). Reported as 0 instead, the pose-invariant centre swung by the
+// pivot's whole offset (1.5 face scales times sin(yaw), 21 px here)
+// on the first covered frame, and the output's head jumped with it.
+TEST(TurningHeadTest, ACoveredHeadKeepsItsTurnWhileFollowed) {
+  const auto s = MakeSimulator("occlusion", [](sim::SimulatorOptions* o) {
+    ASSERT_TRUE(eval::ScaleHeadMotion(3.0, 1.0, &o->head).ok());
+  });
+  const PipelineOptions po = eval::OptionsFor(*s, eval::Method::kSteadiface);
+  // The axis against the true head centre: its offset on the fitted frames
+  // (the pivot's model), and the largest departure from it while followed.
+  double offset = 0.0, worst = 0.0;
+  int fitted = 0, followed = 0;
+  std::vector<double> followed_error;
+  ForEachFrame(*s, po, [&](int, const PipelineFrame& out, const sim::SimTruth& truth) {
+    if (!out.face.located()) return;
+    const double e = FollowedAxisX(po, out.face) - truth.head_px.x();
+    if (out.face.valid) {
+      offset += e;
+      ++fitted;
+    } else {
+      followed_error.push_back(e);
+    }
+  });
+  ASSERT_GT(fitted, 0);
+  offset /= fitted;
+  for (double e : followed_error) worst = std::max(worst, std::abs(e - offset));
+  followed = static_cast<int>(followed_error.size());
+  const eval::Score gyro = RunWith(*s, eval::Method::kGyroOnly, -1.0);
+  const eval::Score ours = RunWith(*s, eval::Method::kSteadiface, -1.0);
+  std::cout << "[ occlusion, head motion x3 ] " << followed << " frames followed, their axis within "
+            << worst << " px of the fitted frames' offset (" << offset << " px); head px: gyro-only "
+            << gyro.head_jitter_px << ", global " << ours.head_jitter_px << "\n";
+  // Measured (seed 1): 2 frames followed, within 1.3 px of the offset
+  // (-3.9 px); 15.75, 6.02 px. With the turn reported as 0 (the build
+  // before): 20.9 px; 9.29 px.
+  EXPECT_GT(followed, 0);
+  EXPECT_LT(worst, 6.0);
+  EXPECT_LT(ours.head_jitter_px, 0.45 * gyro.head_jitter_px);
 }
 
 }  // namespace

@@ -78,6 +78,7 @@ void FaceTracker::Reset() {
   have_last_frame_ = false;
   fitted_last_frame_ = false;
   have_fitted_pose_ = false;
+  recent_poses_ = 0;
   recent_abs_yaw_ = 0.0;
   fitted_appearance_ = 1.0;
   have_last_rotation_ = false;
@@ -150,6 +151,7 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
   have_fitted_pose_ = posed;
   // Without a patch (external landmarks) the appearance was not measured.
   fitted_appearance_ = patch.empty() ? 1.0 : info->appearance;
+  RememberPose(posed, consecutive, *info);
   fitted_yaw_ = info->yaw;
   fitted_pitch_ = info->pitch;
   fitted_roll_ = info->roll;
@@ -460,6 +462,37 @@ bool FaceTracker::StartFollow(Time stamp, double scale) {
   return StopFollowing();
 }
 
+void FaceTracker::RememberPose(bool posed, bool consecutive, const FaceInfo& info) {
+  if (!posed || !consecutive) recent_poses_ = 0;
+  if (!posed) return;
+  if (recent_poses_ == 3) {
+    for (int i = 0; i < 2; ++i) {
+      recent_yaws_[i] = recent_yaws_[i + 1];
+      recent_pitches_[i] = recent_pitches_[i + 1];
+    }
+    --recent_poses_;
+  }
+  recent_yaws_[recent_poses_] = info.yaw;
+  recent_pitches_[recent_poses_] = info.pitch;
+  ++recent_poses_;
+}
+
+void FaceTracker::HeldPose(double* yaw, double* pitch) const {
+  // A cover starts in one region of the face, and the last fits before the
+  // landmarks fail are already dragged by it: PnP's pose of the last one
+  // alone may be off by a spike. The median of the last three is not.
+  if (recent_poses_ < 3) {
+    *yaw = fitted_yaw_;
+    *pitch = fitted_pitch_;
+    return;
+  }
+  const auto median = [](const double* v) {
+    return std::max(std::min(v[0], v[1]), std::min(std::max(v[0], v[1]), v[2]));
+  };
+  *yaw = median(recent_yaws_);
+  *pitch = median(recent_pitches_);
+}
+
 bool FaceTracker::StopFollowing() {
   following_ = false;
   have_own_shift_ = false;
@@ -527,8 +560,12 @@ bool FaceTracker::Follow(const cv::Mat& gray, Time stamp, const Eigen::Vector2d&
   Fill(lm, info);
   info->confidence = flow.inlier_share;
   info->has_pose = true;
+  // A covered face moves by its visible parts' translation: its turn is not
+  // seen, and is held at the last fits' (not 0, which would swing the
+  // pose-invariant centre by its pivot's offset from the landmarks).
   info->yaw = head_turn_.yaw;
   info->pitch = fitted_pitch_;
+  if (following_covered_) HeldPose(&info->yaw, &info->pitch);
   info->roll = fitted_roll_;
   return true;
 }

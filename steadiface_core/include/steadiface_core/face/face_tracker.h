@@ -211,6 +211,11 @@ class FaceTracker {
   bool StartFollow(Time stamp, double scale);
   // Ends a follow (and the head's own motion it carried); returns false.
   bool StopFollowing();
+  // The last fits' poses: remembered after each fit (`consecutive`: the
+  // fit before was of the frame before), and the median of the last three,
+  // the pose a covered face holds.
+  void RememberPose(bool posed, bool consecutive, const FaceInfo& info);
+  void HeldPose(double* yaw, double* pitch) const;
   // Where the camera's rotation moves a still point from the previous
   // frame's pixel into this frame's (face_prediction.cc); zero without the
   // gyro.
@@ -270,6 +275,10 @@ class FaceTracker {
   bool have_fitted_pose_ = false;                // the last fit's pose:
   double fitted_yaw_ = 0.0, fitted_pitch_ = 0.0, fitted_roll_ = 0.0;  // [rad]
   double fitted_yaw_rate_ = 0.0;                 // over consecutive fits [rad/frame]
+  // The yaw and pitch of the last consecutive fits (newest last), for a
+  // covered face's held pose: their median [rad].
+  double recent_yaws_[3] = {}, recent_pitches_[3] = {};
+  int recent_poses_ = 0;
   bool fitted_last_frame_ = false;
   double recent_abs_yaw_ = 0.0;                  // the turn lately, for Follow [rad]
   double fitted_appearance_ = 1.0;               // the last fit's whole-face appearance [-]
