@@ -166,6 +166,7 @@ void AddCompositeFlags(CommandLine* cl, steadiface::CompositeOptions* c) {
   cl->Int("--plate-row-step", &c->plate_row_step);
   cl->Double("--plate-confidence", &c->matte.plate_confidence);
   cl->Int("--matte-absent", &c->matte.absent_frames);
+  cl->Int("--matte-scale", &c->matte.scale);
   cl->Double("--plate-outlier", &c->plate.outlier_level);
   cl->Int("--plate-confirm", &c->plate.confirm_frames);
 }
