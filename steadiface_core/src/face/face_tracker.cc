@@ -35,6 +35,13 @@ constexpr int kCoveredMinInliers = 6;
 // The gain of the first-order filter on PnP's yaw change between
 // consecutive fits: the rate a follow starts from [-].
 constexpr double kFittedYawRateGain = 0.7;
+// A fit that would end a turned follow must read a yaw within this of the
+// followed head's; else it is the landmark model's fit of a face still
+// turned past what it fits (57 deg read as 21 deg on turn_away at 720p),
+// and the follow goes on. At most kMaxRefitRejects such fits in a row are
+// turned away, so a follow that drifted is still ended by the fits [rad].
+constexpr double kRefitMaxYawChange = 0.4;
+constexpr int kMaxRefitRejects = 3;
 }  // namespace
 
 Status FaceTracker::Create(const CameraModel& model,
@@ -113,6 +120,7 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
   last_landmarks_ = c.landmarks;
   fitted_landmarks_ = c.landmarks;
   following_ = false;
+  refit_rejects_ = 0;
   past_profile_ = false;
   last_seen_ = stamp;
   last_located_ = stamp;
@@ -127,14 +135,7 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
   Fill(c.landmarks, info);
   if (options_.estimate_head_pose) {
     const auto t0 = Clock::now();
-    std::vector<Eigen::Vector2d> ideal = c.landmarks;
-    const CameraIntrinsics& k = model_.intrinsics();
-    if (k.HasDistortion()) {
-      for (auto& p : ideal) UndistortPixel(k, p, &p);
-    }
-    CameraIntrinsics pinhole = k;
-    pinhole.distortion = DistortionModel::kNone;
-    info->has_pose = EstimateHeadPose(head_model_, ideal, pinhole, &info->yaw, &info->pitch, &info->roll);
+    info->has_pose = Pose(c.landmarks, &info->yaw, &info->pitch, &info->roll);
     info->timings.pose_ms = MsSince(t0);
   }
   const bool posed = info->has_pose && std::isfinite(info->yaw);
@@ -411,6 +412,10 @@ void FaceTracker::Track(const cv::Mat& gray, const cv::Rect& full, Time stamp,
   } else if (!ok && !in_frame && info->failure == FaceFailure::kNone) {
     info->failure = FaceFailure::kOutOfFrame;
   }
+  if (ok && !RefitAgreesWithTurn(c)) {
+    ok = false;
+    info->failure = FaceFailure::kTurnMismatch;
+  }
   if (ok) {
     TakeFit(gray, c, false, patch, &pc, stamp, info);
     return;
@@ -460,6 +465,29 @@ bool FaceTracker::StartFollow(Time stamp, double scale) {
     return true;
   }
   return StopFollowing();
+}
+
+bool FaceTracker::Pose(const std::vector<Eigen::Vector2d>& landmarks, double* yaw, double* pitch,
+                       double* roll) const {
+  std::vector<Eigen::Vector2d> ideal = landmarks;
+  const CameraIntrinsics& k = model_.intrinsics();
+  if (k.HasDistortion()) {
+    for (auto& p : ideal) UndistortPixel(k, p, &p);
+  }
+  CameraIntrinsics pinhole = k;
+  pinhole.distortion = DistortionModel::kNone;
+  return EstimateHeadPose(head_model_, ideal, pinhole, yaw, pitch, roll);
+}
+
+bool FaceTracker::RefitAgreesWithTurn(const Candidate& c) {
+  if (!following_ || following_covered_ || !options_.estimate_head_pose) return true;
+  double yaw = 0.0, pitch = 0.0, roll = 0.0;
+  if (!Pose(c.landmarks, &yaw, &pitch, &roll) || !std::isfinite(yaw)) return true;
+  if (std::abs(yaw - head_turn_.yaw) <= kRefitMaxYawChange || refit_rejects_ >= kMaxRefitRejects) {
+    return true;
+  }
+  ++refit_rejects_;
+  return false;
 }
 
 void FaceTracker::RememberPose(bool posed, bool consecutive, const FaceInfo& info) {

@@ -36,6 +36,8 @@ const char* FaceFailureName(FaceFailure f) {
       return "bad_input";
     case FaceFailure::kNotSearched:
       return "not_searched";
+    case FaceFailure::kTurnMismatch:
+      return "turn_mismatch";
   }
   return "unknown";
 }

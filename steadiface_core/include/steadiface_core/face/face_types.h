@@ -38,6 +38,9 @@ enum class FaceFailure {
   kBadInput,          ///< empty / tiny / non-8-bit image, or bad landmarks
   kNotSearched,       ///< searching, but no full-frame detection this frame
                       ///< (face.search_interval)
+  kTurnMismatch,      ///< a fit whose yaw disagrees with the followed turned
+                      ///< head's: the landmark model's fit of a face still
+                      ///< turned past what it fits
 };
 
 const char* TrackingStateName(TrackingState s);
