@@ -86,6 +86,7 @@ void FaceTracker::Reset() {
   fitted_last_frame_ = false;
   have_fitted_pose_ = false;
   recent_poses_ = 0;
+  refit_rejects_ = 0;
   recent_abs_yaw_ = 0.0;
   fitted_appearance_ = 1.0;
   have_last_rotation_ = false;
@@ -523,6 +524,7 @@ void FaceTracker::HeldPose(double* yaw, double* pitch) const {
 
 bool FaceTracker::StopFollowing() {
   following_ = false;
+  refit_rejects_ = 0;
   have_own_shift_ = false;
   return false;
 }

@@ -215,13 +215,13 @@ class FaceTracker {
   // fit before was of the frame before), and the median of the last three,
   // the pose a covered face holds.
   void RememberPose(bool posed, bool consecutive, const FaceInfo& info);
+  void HeldPose(double* yaw, double* pitch) const;
   // PnP's head pose of `landmarks` (lens distortion removed) [rad].
   bool Pose(const std::vector<Eigen::Vector2d>& landmarks, double* yaw, double* pitch,
             double* roll) const;
   // Whether a fit may end the turned follow: its yaw near the followed
   // head's (kRefitMaxYawChange), or enough fits turned away already.
   bool RefitAgreesWithTurn(const Candidate& c);
-  void HeldPose(double* yaw, double* pitch) const;
   // Where the camera's rotation moves a still point from the previous
   // frame's pixel into this frame's (face_prediction.cc); zero without the
   // gyro.
@@ -269,7 +269,7 @@ class FaceTracker {
   bool following_covered_ = false;               // ... by translation only
   bool past_profile_ = false;  // a follow ended past the profile: none until the next fit
   HeadTurn head_turn_;                           // the followed head
-  int refit_rejects_ = 0;  // fits turned away by RefitAgreesWithTurn since the last fit
+  int refit_rejects_ = 0;  // fits RefitAgreesWithTurn turned away in this follow
   // The head's own motion over the last frame, beyond the camera's
   // rotation, when it was located in both frames [px/frame].
   Eigen::Vector2d own_shift_ = Eigen::Vector2d::Zero();
