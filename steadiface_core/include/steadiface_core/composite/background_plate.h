@@ -4,9 +4,9 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "steadiface_core/camera/output_geometry.h"
 #include "steadiface_core/common/status.h"
 #include "steadiface_core/composite/layer_homography.h"
-#include "steadiface_core/camera/output_geometry.h"
 
 namespace steadiface {
 
@@ -54,7 +54,8 @@ Status ValidateBackgroundPlateOptions(const BackgroundPlateOptions& options);
 /// frames per pixel. Causal; one per stream; not thread-safe.
 class BackgroundPlate {
  public:
-  BackgroundPlate(const OutputGeometry& output, const BackgroundPlateOptions& options);
+  BackgroundPlate(const OutputGeometry& output,
+                  const BackgroundPlateOptions& options);
 
   /// Forgets everything (time jump, new epoch).
   void Reset();
@@ -63,25 +64,27 @@ class BackgroundPlate {
   /// output leaves it, restarts it after a large turn.
   void Begin(const LayerView& view, double time_s);
   /// The plate as the background camera sees it over output rectangle
-  /// `roi`: colour (the images' type) and validity (CV_32F in [0, 1]: 1 while the
-  /// pixel is fresh, fading to 0 over the last quarter of max_age_s, 0 where
-  /// never seen).
+  /// `roi`: colour (the images' type) and validity (CV_32F in [0, 1]: 1 while
+  /// the pixel is fresh, fading to 0 over the last quarter of max_age_s, 0
+  /// where never seen).
   void Sample(const cv::Rect& roi, cv::Mat* colour, cv::Mat* valid) const;
   /// The same at `scale` pictures' pixels per output pixel (< 1: smaller).
-  void Sample(const cv::Rect& roi, double scale, cv::Mat* colour, cv::Mat* valid) const;
+  void Sample(const cv::Rect& roi, double scale, cv::Mat* colour,
+              cv::Mat* valid) const;
   /// The plate at plate pixel (px, py), bilinear, into `colour` (the
   /// images' channels); returns its freshness in [0, 1] (0: not seen,
   /// expired or outside; then `colour` is not written). view_to_plate()
   /// maps output pixels of the current view to plate pixels.
   float SamplePlate(double px, double py, uchar* colour) const;
   const Eigen::Matrix3d& view_to_plate() const { return view_to_plate_; }
-  /// Takes this frame's background (`image_roi`, 8-bit, 1-4 channels, output rectangle
-  /// `roi`) where `matte_roi` (subject coverage: CV_32F in [0, 1], or CV_8U
-  /// in 1/255 steps) is below `background_below`, on every `row_step`-th plate row from `row_phase`
-  /// (a caller alternating the phase spreads the work over frames). Returns
-  /// false (and restarts the plate) on a scene cut.
-  bool Update(const cv::Mat& image_roi, const cv::Mat& matte_roi, const cv::Rect& roi,
-              float background_below, int row_step = 1, int row_phase = 0);
+  /// Takes this frame's background (`image_roi`, 8-bit, 1-4 channels, output
+  /// rectangle `roi`) where `matte_roi` (subject coverage: CV_32F in [0, 1], or
+  /// CV_8U in 1/255 steps) is below `background_below`, on every `row_step`-th
+  /// plate row from `row_phase` (a caller alternating the phase spreads the
+  /// work over frames). Returns false (and restarts the plate) on a scene cut.
+  bool Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
+              const cv::Rect& roi, float background_below, int row_step = 1,
+              int row_phase = 0);
 
   /// Fraction of the plate's pixels that are fresh [0-1] (on a 4 px grid).
   double Coverage() const;
@@ -96,15 +99,18 @@ class BackgroundPlate {
 
  private:
   // Plate pixel <- output pixel of the current view.
-  Eigen::Matrix3d PlateFromView() const { return HomographyBetween(anchor_, view_); }
+  Eigen::Matrix3d PlateFromView() const {
+    return HomographyBetween(anchor_, view_);
+  }
   bool ViewInside() const;
   // Update's step over `width` plate pixels of row py from x0: each takes
   // the picture (`image`, over output rectangle `roi`) at the view pixel G
   // maps it to, where `matte` (1/255 steps, over `roi`) is below `below`,
   // unless it is a confirmed pixel's outlier (an unconfirmed one is
   // replaced). Writes plate row py only, so rows may run in parallel.
-  void UpdateRow(const cv::Mat& image, const cv::Mat& matte, int below, const Eigen::Matrix3d& G,
-                 const cv::Rect& roi, int x0, int py, int width, double* diff, int* compared);
+  void UpdateRow(const cv::Mat& image, const cv::Mat& matte, int below,
+                 const Eigen::Matrix3d& G, const cv::Rect& roi, int x0, int py,
+                 int width, double* diff, int* compared);
   void Reproject();
 
   const OutputGeometry output_;
