@@ -4,10 +4,13 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
 #include "composite/row_stripes.h"
+#include "steadiface_core/warp/mesh_sampler.h"
+#include "steadiface_core/warp/warper.h"
 
 namespace steadiface {
 namespace {
@@ -16,6 +19,73 @@ constexpr float kNever = -std::numeric_limits<float>::infinity();
 
 bool In(double v, double lo, double hi) {
   return std::isfinite(v) && v >= lo && v <= hi;
+}
+
+// The view-point mesh's largest departure from the homography it stands
+// for, well below the sampler's 1/32 px [px].
+constexpr double kViewMeshError = 0.01;
+
+// The view point of plate pixel (x, y): G maps plate to view pixels.
+Eigen::Vector2d ViewPoint(const Eigen::Matrix3d& G, double x, double y) {
+  const Eigen::Vector3d q = G * Eigen::Vector3d(x, y, 1.0);
+  return q.head<2>() / q.z();
+}
+
+// The side of the view-point mesh's cells over plate rectangle `target`
+// (rows `step` apart): the interpolation error grows with the side squared,
+// so it is measured for 64 px cells at the target's corners and edge
+// midpoints (where the homography bends most) and the side scaled to
+// kViewMeshError; a power of two in [4, 128] [px].
+int ViewMeshCell(const Eigen::Matrix3d& G, const cv::Rect& target, int step) {
+  const double L = 64.0;
+  double error = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double x = target.x + i * std::max(0.0, target.width - L) / 2.0;
+      const double y =
+          target.y + j * std::max(0.0, target.height - L * step) / 2.0;
+      const Eigen::Vector2d mid =
+          (ViewPoint(G, x, y) + ViewPoint(G, x + L, y) +
+           ViewPoint(G, x, y + L * step) + ViewPoint(G, x + L, y + L * step)) /
+          4.0;
+      const Eigen::Vector2d truth =
+          ViewPoint(G, x + L / 2.0, y + L * step / 2.0);
+      if (mid.allFinite() && truth.allFinite())
+        error = std::max(error, (mid - truth).lpNorm<Eigen::Infinity>());
+    }
+  }
+  int cell = 128;
+  while (cell > 4 && error * (cell / L) * (cell / L) > kViewMeshError)
+    cell /= 2;
+  return cell;
+}
+
+// The view points (relative to `roi`) of plate rows y0, y0 + step, ... (`rows`
+// of them) from column x0, `width` wide, as a warp mesh: output pixel (u, v)
+// is plate pixel (x0 + u, y0 + v step), and G maps plate to view pixels.
+WarpMesh ViewPointMesh(const Eigen::Matrix3d& G, const cv::Rect& roi, int x0,
+                       int y0, int step, int width, int rows, int cell) {
+  WarpMesh m;
+  const auto nodes = [cell](int n) {
+    std::vector<double> at;
+    for (int i = 0; i < n - 1; i += cell) at.push_back(i);
+    at.push_back(std::max(0, n - 1));
+    if (at.size() < 2) at.push_back(at.back() + 1.0);
+    return at;
+  };
+  m.u = nodes(width);
+  m.v = nodes(rows);
+  m.cols = static_cast<int>(m.u.size());
+  m.rows = static_cast<int>(m.v.size());
+  for (double v : m.v) {
+    for (double u : m.u) {
+      const Eigen::Vector3d q = G * Eigen::Vector3d(x0 + u, y0 + v * step, 1.0);
+      m.source.emplace_back(static_cast<float>(q.x() / q.z() - roi.x),
+                            static_cast<float>(q.y() / q.z() - roi.y));
+      m.source_row.push_back(m.source.back().y());
+    }
+  }
+  return m;
 }
 
 }  // namespace
@@ -177,9 +247,9 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
   const cv::Rect target = MapRect(PlateFromView(), roi, all);
   if (target.empty()) return true;
   // Each plate pixel of the target looks up the view pixel it shows: the
-  // matte there (nearest; outside the roi: not taken) and, where it is the
-  // scene, the picture (bilinear). Every `row_step`-th row, starting at
-  // `row_phase`.
+  // matte there (nearest; outside the roi: not taken) and the picture
+  // (bilinear, through a mesh of the view points). Every `row_step`-th row,
+  // starting at `row_phase`.
   cv::Mat matte8 = matte_roi;
   if (matte_roi.depth() != CV_8U) matte_roi.convertTo(matte8, CV_8U, 255.0);
   const int below = static_cast<int>(std::ceil(background_below * 255.0f));
@@ -187,12 +257,21 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
   const int step = std::max(1, row_step),
             first = target.y + ((row_phase % step) + step) % step;
   const int rows = (target.y + target.height - first + step - 1) / step;
+  if (rows <= 0) return true;
+  const int cell = ViewMeshCell(G, target, step);
+  SampleMesh(
+      ViewPointMesh(G, roi, target.x, first, step, target.width, rows, cell),
+      image_roi, target.width, rows, &in_);
   double diffs[composite_internal::kRowStripes] = {};
   int counts[composite_internal::kRowStripes] = {};
   composite_internal::ForRowStripes(rows, [&](int k, int i0, int i1) {
+    std::vector<uchar> take(target.width);
     for (int i = i0; i < i1; ++i) {
-      UpdateRow(image_roi, matte8, below, G, roi, target.x, first + i * step,
-                target.width, &diffs[k], &counts[k]);
+      const int py = first + i * step;
+      SceneInView(matte8, below, G, roi, target.x, py, target.width, cell,
+                  take.data());
+      UpdateRow(in_.ptr<uchar>(i), take.data(), target.x, py, target.width,
+                &diffs[k], &counts[k]);
     }
   });
   double diff = 0.0;
@@ -207,10 +286,32 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
   return true;
 }
 
-void BackgroundPlate::UpdateRow(const cv::Mat& image, const cv::Mat& matte,
-                                int below, const Eigen::Matrix3d& G,
-                                const cv::Rect& roi, int x0, int py, int width,
-                                double* diff, int* compared) {
+void BackgroundPlate::SceneInView(const cv::Mat& matte, int below,
+                                  const Eigen::Matrix3d& G, const cv::Rect& roi,
+                                  int x0, int py, int width, int cell,
+                                  uchar* take) {
+  // The view point is exact at every `cell`-th pixel and stepped linearly
+  // between (as the picture's mesh is).
+  const float w1 = roi.width - 1.0f, h1 = roi.height - 1.0f;
+  for (int u0 = 0; u0 < width; u0 += cell) {
+    const int n = std::min(cell, width - u0);
+    const Eigen::Vector3d a = G * Eigen::Vector3d(x0 + u0, py, 1.0);
+    const Eigen::Vector3d b = G * Eigen::Vector3d(x0 + u0 + n, py, 1.0);
+    float vx = static_cast<float>(a.x() / a.z() - roi.x),
+          vy = static_cast<float>(a.y() / a.z() - roi.y);
+    const float dx = (static_cast<float>(b.x() / b.z() - roi.x) - vx) / n;
+    const float dy = (static_cast<float>(b.y() / b.z() - roi.y) - vy) / n;
+    for (int u = u0; u < u0 + n; ++u, vx += dx, vy += dy) {
+      take[u] = vx >= 0.0f && vy >= 0.0f && vx <= w1 && vy <= h1 &&
+                matte.ptr<uchar>(static_cast<int>(
+                    vy + 0.5f))[static_cast<int>(vx + 0.5f)] < below;
+    }
+  }
+}
+
+void BackgroundPlate::UpdateRow(const uchar* in, const uchar* take, int x0,
+                                int py, int width, double* diff,
+                                int* compared) {
   const int cn = plate_.channels();
   uchar* p = plate_.ptr<uchar>(py) + cn * x0;
   float* seen = seen_.ptr<float>(py) + x0;
@@ -221,37 +322,12 @@ void BackgroundPlate::UpdateRow(const cv::Mat& image, const cv::Mat& matte,
   const int outlier = static_cast<int>(options_.outlier_level * cn);
   // The running average's weight of this frame, in 1/256 steps.
   const int rate = static_cast<int>(std::lround(options_.update_rate * 256.0));
-  const float w1 = roi.width - 1.0f, h1 = roi.height - 1.0f;
-  const Eigen::Vector3d r0 = G * Eigen::Vector3d(x0, py, 1.0) -
-                             Eigen::Vector3d(roi.x, roi.y, 0.0) *
-                                 (G(2, 0) * x0 + G(2, 1) * py + G(2, 2));
-  // (r0 is the view point relative to the roi, homogeneous; each step adds
-  // G's first column, less the roi's corner times its z step.)
-  const double dx = G(0, 0) - roi.x * G(2, 0), dy = G(1, 0) - roi.y * G(2, 0),
-               dz = G(2, 0);
-  double X = r0.x(), Y = r0.y(), Z = r0.z();
   // The row's sums in registers (a sum kept through the pointers cost a
   // fifth of the row's time).
   int64_t diff_sum = 0;
   int diff_count = 0;
-  for (int x = 0; x < width; ++x, X += dx, Y += dy, Z += dz, p += cn) {
-    const float iz = static_cast<float>(1.0 / Z);
-    const float vx = static_cast<float>(X) * iz,
-                vy = static_cast<float>(Y) * iz;
-    if (!(vx >= 0.0f && vy >= 0.0f && vx <= w1 && vy <= h1)) continue;
-    if (matte.ptr<uchar>(
-            static_cast<int>(vy + 0.5f))[static_cast<int>(vx + 0.5f)] >= below)
-      continue;
-    const int ix = std::min(static_cast<int>(vx), image.cols - 2);
-    const int iy = std::min(static_cast<int>(vy), image.rows - 2);
-    const float fx = vx - ix, fy = vy - iy;
-    const uchar* a = image.ptr<uchar>(iy) + cn * ix;
-    const uchar* b = image.ptr<uchar>(iy + 1) + cn * ix;
-    int in[4];
-    for (int c = 0; c < cn; ++c) {
-      in[c] = static_cast<int>((1 - fy) * ((1 - fx) * a[c] + fx * a[c + cn]) +
-                               fy * ((1 - fx) * b[c] + fx * b[c + cn]) + 0.5f);
-    }
+  for (int x = 0; x < width; ++x, p += cn, in += cn) {
+    if (!take[x]) continue;
     const bool fresh = now - seen[x] < max_age;
     int d = 0;
     if (fresh) {
@@ -272,7 +348,7 @@ void BackgroundPlate::UpdateRow(const cv::Mat& image, const cv::Mat& matte,
       // New, expired, or an unconfirmed value this frame disagrees with
       // (the value first taken may have been a subject's edge; kept, it
       // would turn the scene away as its outlier until it expired).
-      for (int c = 0; c < cn; ++c) p[c] = static_cast<uchar>(in[c]);
+      for (int c = 0; c < cn; ++c) p[c] = in[c];
       agreed[x] = 1;
     }
     seen[x] = now;

@@ -103,14 +103,19 @@ class BackgroundPlate {
     return HomographyBetween(anchor_, view_);
   }
   bool ViewInside() const;
-  // Update's step over `width` plate pixels of row py from x0: each takes
-  // the picture (`image`, over output rectangle `roi`) at the view pixel G
-  // maps it to, where `matte` (1/255 steps, over `roi`) is below `below`,
+  // Whether each of `width` plate pixels of row py from x0 is taken: its
+  // view pixel (G maps plate to view pixels) is inside output rectangle
+  // `roi` and `matte` (1/255 steps, over `roi`) is below `below` there
+  // (nearest; the view point exact every `cell` pixels, linear between).
+  static void SceneInView(const cv::Mat& matte, int below,
+                          const Eigen::Matrix3d& G, const cv::Rect& roi, int x0,
+                          int py, int width, int cell, uchar* take);
+  // Update's step over plate row py from x0: `in` is the picture at each of
+  // its `width` pixels' view points; a pixel marked in `take` is taken,
   // unless it is a confirmed pixel's outlier (an unconfirmed one is
   // replaced). Writes plate row py only, so rows may run in parallel.
-  void UpdateRow(const cv::Mat& image, const cv::Mat& matte, int below,
-                 const Eigen::Matrix3d& G, const cv::Rect& roi, int x0, int py,
-                 int width, double* diff, int* compared);
+  void UpdateRow(const uchar* in, const uchar* take, int x0, int py, int width,
+                 double* diff, int* compared);
   void Reproject();
 
   const OutputGeometry output_;
@@ -121,6 +126,9 @@ class BackgroundPlate {
   // CV_8U: frames that agreed with each pixel since it was last replaced
   // (saturating).
   cv::Mat agreed_;
+  // Update's scratch: the picture at the learnt plate pixels' view points
+  // (at most the plate's size).
+  cv::Mat in_;
   bool anchored_ = false;
   LayerView anchor_, view_;
   Eigen::Matrix3d view_to_plate_ = Eigen::Matrix3d::Identity();
