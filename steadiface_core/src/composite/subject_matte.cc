@@ -19,6 +19,25 @@ bool In(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && 
 
 float Clamp(float v, float lo, float hi) { return std::min(hi, std::max(lo, v)); }
 
+// `in` averaged over s x s blocks into `size` (INTER_AREA). A power of two
+// halves it step by step: OpenCV vectorizes the halving, not the larger
+// factors (a 720p colour frame to 1/4: 0.65 ms in one step, 0.20 ms in two
+// halvings; each halving rounds, so they differ by at most a grey level).
+void DownscaleArea(const cv::Mat& in, int s, const cv::Size& size, cv::Mat* out) {
+  if (s < 2 || (s & (s - 1)) != 0) {
+    cv::resize(in, *out, size, 0, 0, cv::INTER_AREA);
+    return;
+  }
+  cv::Mat level = in;
+  for (int k = s; k > 1; k /= 2) {
+    cv::Mat half;
+    const cv::Size next = k == 2 ? size : cv::Size((level.cols + 1) / 2, (level.rows + 1) / 2);
+    cv::resize(level, half, next, 0, 0, cv::INTER_AREA);
+    level = half;
+  }
+  *out = level;
+}
+
 
 int Bin(const uchar* px, int cn) {
   if (cn == 1) return px[0] * kLevels / 256;
@@ -120,9 +139,9 @@ void SubjectMatte::Estimate(const MatteInputs& in, cv::Rect* active, cv::Mat* ma
   low.s = s;
   const cv::Size small((in.background.cols + s - 1) / s, (in.background.rows + s - 1) / s);
   cv::Mat bg_small, subject_small;
-  cv::resize(in.background, bg_small, small, 0, 0, cv::INTER_AREA);
+  DownscaleArea(in.background, s, small, &bg_small);
   low.background = ToGrey(bg_small);
-  cv::resize(in.subject, subject_small, small, 0, 0, cv::INTER_AREA);
+  DownscaleArea(in.subject, s, small, &subject_small);
   low.subject = ToGrey(subject_small);
   low.roi = LowRoi(in.roi, small);
   low.colour = bg_small(low.roi);
