@@ -196,8 +196,8 @@ TEST(BackgroundPlateTest, LearnsThroughAViewTurnedFromItsAnchorWithoutSmearing) 
   // Through the anchor's own view every view point is a whole pixel: the
   // plate is the picture. Turned, the sharp texture loses to the two
   // bilinear resamplings (learnt, sampled back): 1.58 grey levels with the
-  // view points exact (a 4 px mesh); a 64 px mesh, up to 0.1 px off here,
-  // gives 1.79, and a 128 px one 3.42.
+  // view points exact (a 4 px mesh); a fixed 64 px mesh gives 1.79, and a
+  // fixed 128 px one 3.42.
   EXPECT_LT(straight, 0.01);
   EXPECT_LT(turned, 1.65);
 }
