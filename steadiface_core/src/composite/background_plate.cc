@@ -79,13 +79,40 @@ WarpMesh ViewPointMesh(const Eigen::Matrix3d& G, const cv::Rect& roi, int x0,
   m.rows = static_cast<int>(m.v.size());
   for (double v : m.v) {
     for (double u : m.u) {
-      const Eigen::Vector3d q = G * Eigen::Vector3d(x0 + u, y0 + v * step, 1.0);
-      m.source.emplace_back(static_cast<float>(q.x() / q.z() - roi.x),
-                            static_cast<float>(q.y() / q.z() - roi.y));
+      const Eigen::Vector2d q =
+          ViewPoint(G, x0 + u, y0 + v * step) - Eigen::Vector2d(roi.x, roi.y);
+      m.source.push_back(q.cast<float>());
       m.source_row.push_back(m.source.back().y());
     }
   }
   return m;
+}
+
+// Whether each of `width` plate pixels of row py from x0 is taken: its view
+// pixel (G maps plate to view pixels) is inside output rectangle `roi` and
+// `matte` (1/255 steps, over `roi`) is below `below` there (nearest; the
+// view point exact every `cell` pixels, linear between).
+void SceneInView(const cv::Mat& matte, int below, const Eigen::Matrix3d& G,
+                 const cv::Rect& roi, int x0, int py, int width, int cell,
+                 uchar* take) {
+  // The view point is exact at every `cell`-th pixel and stepped linearly
+  // between (as the picture's mesh is).
+  const float w1 = roi.width - 1.0f, h1 = roi.height - 1.0f;
+  const Eigen::Vector2d corner(roi.x, roi.y);
+  for (int u0 = 0; u0 < width; u0 += cell) {
+    const int n = std::min(cell, width - u0);
+    const Eigen::Vector2f a =
+        (ViewPoint(G, x0 + u0, py) - corner).cast<float>();
+    const Eigen::Vector2f b =
+        (ViewPoint(G, x0 + u0 + n, py) - corner).cast<float>();
+    float vx = a.x(), vy = a.y();
+    const float dx = (b.x() - vx) / n, dy = (b.y() - vy) / n;
+    for (int u = u0; u < u0 + n; ++u, vx += dx, vy += dy) {
+      take[u] = vx >= 0.0f && vy >= 0.0f && vx <= w1 && vy <= h1 &&
+                matte.ptr<uchar>(static_cast<int>(
+                    vy + 0.5f))[static_cast<int>(vx + 0.5f)] < below;
+    }
+  }
 }
 
 }  // namespace
@@ -284,29 +311,6 @@ bool BackgroundPlate::Update(const cv::Mat& image_roi, const cv::Mat& matte_roi,
     return false;
   }
   return true;
-}
-
-void BackgroundPlate::SceneInView(const cv::Mat& matte, int below,
-                                  const Eigen::Matrix3d& G, const cv::Rect& roi,
-                                  int x0, int py, int width, int cell,
-                                  uchar* take) {
-  // The view point is exact at every `cell`-th pixel and stepped linearly
-  // between (as the picture's mesh is).
-  const float w1 = roi.width - 1.0f, h1 = roi.height - 1.0f;
-  for (int u0 = 0; u0 < width; u0 += cell) {
-    const int n = std::min(cell, width - u0);
-    const Eigen::Vector3d a = G * Eigen::Vector3d(x0 + u0, py, 1.0);
-    const Eigen::Vector3d b = G * Eigen::Vector3d(x0 + u0 + n, py, 1.0);
-    float vx = static_cast<float>(a.x() / a.z() - roi.x),
-          vy = static_cast<float>(a.y() / a.z() - roi.y);
-    const float dx = (static_cast<float>(b.x() / b.z() - roi.x) - vx) / n;
-    const float dy = (static_cast<float>(b.y() / b.z() - roi.y) - vy) / n;
-    for (int u = u0; u < u0 + n; ++u, vx += dx, vy += dy) {
-      take[u] = vx >= 0.0f && vy >= 0.0f && vx <= w1 && vy <= h1 &&
-                matte.ptr<uchar>(static_cast<int>(
-                    vy + 0.5f))[static_cast<int>(vx + 0.5f)] < below;
-    }
-  }
 }
 
 void BackgroundPlate::UpdateRow(const uchar* in, const uchar* take, int x0,

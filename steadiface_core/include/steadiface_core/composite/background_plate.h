@@ -103,13 +103,6 @@ class BackgroundPlate {
     return HomographyBetween(anchor_, view_);
   }
   bool ViewInside() const;
-  // Whether each of `width` plate pixels of row py from x0 is taken: its
-  // view pixel (G maps plate to view pixels) is inside output rectangle
-  // `roi` and `matte` (1/255 steps, over `roi`) is below `below` there
-  // (nearest; the view point exact every `cell` pixels, linear between).
-  static void SceneInView(const cv::Mat& matte, int below,
-                          const Eigen::Matrix3d& G, const cv::Rect& roi, int x0,
-                          int py, int width, int cell, uchar* take);
   // Update's step over plate row py from x0: `in` is the picture at each of
   // its `width` pixels' view points; a pixel marked in `take` is taken,
   // unless it is a confirmed pixel's outlier (an unconfirmed one is
