@@ -29,6 +29,16 @@ constexpr int kFollowRedetectFrames = 3;
 // The gain of the first-order filter on PnP's yaw change between
 // consecutive fits: the rate a follow starts from [-].
 constexpr double kFittedYawRateGain = 0.7;
+// A fit whose regions disagree (a cover over part of the face) and whose
+// yaw leaves the trend of the two fits before it by more than this (the
+// second difference of the three) was dragged by the cover [rad]. The hand
+// of `occlusion` at twice the head's motion, seeds 1-3, dragged the last
+// fit by 0.12-0.17 rad; on the other fits whose regions disagreed (mostly
+// a turning face: turn_away with the relief and the mean-face heads and
+// turning twice as fast, occlusion at up to three times and walk at up to
+// twice the head's motion, seeds 1-3) the second difference was at most
+// 0.06 (docs/evaluation.md).
+constexpr double kDraggedYawJump = 0.09;
 }  // namespace
 
 Status FaceTracker::Create(const CameraModel& model,
@@ -132,11 +142,6 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
   fitted_yaw_rate_ =
       consecutive ? fitted_yaw_rate_ + kFittedYawRateGain * (info->yaw - fitted_yaw_ - fitted_yaw_rate_)
                   : 0.0;
-  // How far the face turned lately: the largest fitted |yaw|, forgotten at
-  // kTurnMemoryRadPerS (PnP's yaw is noisy frame to frame).
-  const double dt = acquiring ? 1e9 : std::max(0.0, ToSeconds(stamp - previous_fit));
-  recent_abs_yaw_ = std::max(posed ? std::abs(info->yaw) : 0.0,
-                             recent_abs_yaw_ - kTurnMemoryRadPerS * std::min(dt, 10.0));
   have_fitted_pose_ = posed;
   // Without a patch (external landmarks) the appearance was not measured.
   fitted_appearance_ = patch.empty() ? 1.0 : info->appearance;
@@ -144,6 +149,21 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
   fitted_yaw_ = info->yaw;
   fitted_pitch_ = info->pitch;
   fitted_roll_ = info->roll;
+  // How far the face turned lately: the largest fitted |yaw|, forgotten at
+  // kTurnMemoryRadPerS (PnP's yaw is noisy frame to frame). A hand arriving
+  // over the face drags the landmarks into a spike of yaw, which would
+  // start the follow of a turned head instead of a covered one: a fit whose
+  // regions disagree (RegionAppearance < 1) and whose yaw jumps off the
+  // trend (kDraggedYawJump) counts with the median of the last three fits'
+  // yaw (HeldPose).
+  double turn = info->yaw, pitch = 0.0;
+  const bool dragged =
+      info->region_appearance < 1.0 && recent_poses_ == 3 &&
+      std::abs(recent_yaws_[2] - 2.0 * recent_yaws_[1] + recent_yaws_[0]) > kDraggedYawJump;
+  if (dragged) HeldPose(&turn, &pitch);
+  const double dt = acquiring ? 1e9 : std::max(0.0, ToSeconds(stamp - previous_fit));
+  recent_abs_yaw_ = std::max(posed ? std::abs(turn) : 0.0,
+                             recent_abs_yaw_ - kTurnMemoryRadPerS * std::min(dt, 10.0));
   Relock(c, acquiring, patch, *info);
 }
 
