@@ -333,7 +333,7 @@ TEST(TurningHeadTest, ACoveredHeadKeepsItsTurnWhileFollowed) {
 }
 
 // occlusion with twice the head's motion: the last fit before the hand
-// covers the face has its regions disagreeing (the mouth's 0.59) and is
+// covers the face has its regions disagreeing (the lowest at 0.59) and is
 // dragged into a yaw spike (PnP 0.14 -> 0.30 rad in one frame). Taken at
 // its word, that yaw marked the head as turned, the follow took it as a
 // turning cylinder whose face swung 0.41 rad on its first frame, and the
