@@ -153,12 +153,13 @@ void FaceTracker::Accept(const Candidate& c, bool acquiring, const cv::Mat& patc
   // kTurnMemoryRadPerS (PnP's yaw is noisy frame to frame). A hand arriving
   // over the face drags the landmarks into a spike of yaw, which would
   // start the follow of a turned head instead of a covered one: a fit whose
-  // regions disagree (RegionAppearance < 1) and whose yaw jumps off the
-  // trend (kDraggedYawJump) counts with the median of the last three fits'
-  // yaw (HeldPose).
+  // regions disagree (RegionAppearance < 1; measured only with a patch, not
+  // for external landmarks) and whose yaw jumps off the trend
+  // (kDraggedYawJump) counts with the median of the last three fits' yaw
+  // (HeldPose).
   double turn = info->yaw, pitch = 0.0;
   const bool dragged =
-      info->region_appearance < 1.0 && recent_poses_ == 3 &&
+      !patch.empty() && info->region_appearance < 1.0 && recent_poses_ == 3 &&
       std::abs(recent_yaws_[2] - 2.0 * recent_yaws_[1] + recent_yaws_[0]) > kDraggedYawJump;
   if (dragged) HeldPose(&turn, &pitch);
   const double dt = acquiring ? 1e9 : std::max(0.0, ToSeconds(stamp - previous_fit));
