@@ -96,13 +96,13 @@ void SceneInView(const cv::Mat& matte, int below, const Eigen::Matrix3d& G,
                  const cv::Rect& roi, int x0, int py, int width, int cell,
                  uchar* take) {
   // The view point is exact at every `cell`-th pixel and stepped linearly
-  // between (as the picture's mesh is).
+  // between (as the picture's mesh is); each stretch starts where the one
+  // before it ended.
   const float w1 = roi.width - 1.0f, h1 = roi.height - 1.0f;
   const Eigen::Vector2d corner(roi.x, roi.y);
+  Eigen::Vector2f a = (ViewPoint(G, x0, py) - corner).cast<float>();
   for (int u0 = 0; u0 < width; u0 += cell) {
     const int n = std::min(cell, width - u0);
-    const Eigen::Vector2f a =
-        (ViewPoint(G, x0 + u0, py) - corner).cast<float>();
     const Eigen::Vector2f b =
         (ViewPoint(G, x0 + u0 + n, py) - corner).cast<float>();
     float vx = a.x(), vy = a.y();
@@ -112,6 +112,7 @@ void SceneInView(const cv::Mat& matte, int below, const Eigen::Matrix3d& G,
                 matte.ptr<uchar>(static_cast<int>(
                     vy + 0.5f))[static_cast<int>(vx + 0.5f)] < below;
     }
+    a = b;
   }
 }
 
