@@ -36,7 +36,10 @@ std::vector<std::string> Split(const std::string& s) {
 const char kUsage[] =
     "usage: steadiface_evaluate --data DIR --out DIR [--presets a,b]\n"
     "       [--methods none,gyro-only,steadiface,steadiface-layered,none/video,\n"
-    "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake] [--duration S]\n"
+    "        steadiface/video,ffmpeg-vidstab,ffmpeg-deshake,ffmpeg-vidstab/aligned,\n"
+    "        ffmpeg-deshake/aligned] [--duration S]\n"
+    "       (/video: scored from the output video; /aligned: a peer's frames\n"
+    "        aligned to the input's, the truth scored through them exactly)\n"
     "       [--size WxH] [--seed N] [--render] [--crop R]\n"
     "       [--band W] [--band-inside F] [--outline-margin CELLS] [--max-offset C] [--offset-lowpass HZ]\n"
     "       [--yield-to-background] (the layered warp's warp/layered/* options,\n"
@@ -81,6 +84,12 @@ const char kUsage[] =
     "         subject_reach_hold: H follows the slow part of that position)\n"
     "       [--head-w-stay W] [--head-d-ref D] (head.w_stay, head.d_ref: the\n"
     "         head target's smoothing, Eq. 1)\n"
+    "       [--vidstab-zoom P] [--vidstab-smoothing N] (the vid.stab peer's\n"
+    "         vidstabtransform zoom, optzoom off: it shows 1 - P/100 of the\n"
+    "         width, so 30 is the default 0.70 crop's view; and its smoothing;\n"
+    "         default its own)\n"
+    "       [--intentional-window S] (stabilizer.intentional_window: E_r C0\n"
+    "         follows the mean rotation rate over the last S; 0 = the paper)\n"
     "       [--protrusion-alpha-face A] (terms.protrusion_alpha_face: E_p's\n"
     "         tolerance while a face is fitted; 0.002 is the stiff no-face wall)\n"
     "       [--feasible-set] (per stabilizer method also feasible_<preset>_<method>.csv:\n"
@@ -142,6 +151,9 @@ void AddPipelineFlags(CommandLine* cl, EvaluationOptions* o) {
   cl->Double("--pivot-depth", &o->pose_pivot_depth);
   cl->Double("--head-w-stay", &o->head_w_stay).Double("--head-d-ref", &o->head_d_ref);
   cl->Double("--protrusion-alpha-face", &o->protrusion_alpha_face);
+  cl->Double("--intentional-window", &o->intentional_window_s);
+  cl->Double("--vidstab-zoom", &o->peer.vidstab_zoom_percent);
+  cl->Int("--vidstab-smoothing", &o->peer.vidstab_smoothing);
   cl->Double("--subject-reach", &o->subject_reach).Double("--reach-lowpass", &o->reach_lowpass_hz);
   cl->Double("--reach-hold", &o->reach_hold);
   steadiface::LayerBlendOptions* b = &o->blend;

@@ -7,11 +7,15 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <set>
 
+#include <opencv2/imgproc.hpp>
+
 #include "eval/evaluation_files.h"
 #include "steadiface_core/eval/ffmpeg_baseline.h"
+#include "steadiface_core/eval/peer_alignment.h"
 #include "steadiface_core/eval/run_methods.h"
 #include "steadiface_core/eval/video_scorer.h"
 #include "steadiface_core/pipeline/pipeline.h"
@@ -27,11 +31,16 @@ bool KnownMethod(const std::string& name) {
       "none",           "gyro-only",       "steadiface",           "steadiface-layered",
       "steadiface-layered/video", "none/video", "steadiface-composite",
       "steadiface-composite/video", "steadiface/video", "gyro-only/video", "ffmpeg-vidstab",
-      "ffmpeg-deshake"};
+      "ffmpeg-deshake", "ffmpeg-vidstab/aligned", "ffmpeg-deshake/aligned"};
   return std::find(std::begin(kNames), std::end(kNames), name) != std::end(kNames);
 }
 
 bool IsPeer(const std::string& name) { return name.compare(0, 7, "ffmpeg-") == 0; }
+
+// A peer scored through its frames aligned to the input (AlignPeerFrame).
+bool IsAligned(const std::string& name) {
+  return name.size() > 8 && name.compare(name.size() - 8, 8, "/aligned") == 0;
+}
 
 bool IsVideo(const std::string& name) {
   return name.size() > 6 && name.compare(name.size() - 6, 6, "/video") == 0;
@@ -120,6 +129,9 @@ Status PipelineOptionsFor(const EvaluationOptions& o, const sim::Simulator& sim,
   po.rotation_source = o.rotation_source;
   if (std::isfinite(o.head_w_stay)) po.stabilizer.head.w_stay = o.head_w_stay;
   if (std::isfinite(o.head_d_ref)) po.stabilizer.head.d_ref = o.head_d_ref;
+  if (std::isfinite(o.intentional_window_s)) {
+    po.stabilizer.intentional_window_s = o.intentional_window_s;
+  }
   if (std::isfinite(o.protrusion_alpha_face)) {
     po.stabilizer.terms.protrusion_alpha_face = o.protrusion_alpha_face;
   }
@@ -158,7 +170,9 @@ class PresetRun {
 
  private:
   Status MakeInputVideo();
-  Status RunPeer(const std::string& name, VideoScorer* vs, RunFigures* run);
+  Status RunPeer(const std::string& name, VideoScorer* vs, Score* sc, RunFigures* run);
+  Status ScoreAligned(const std::string& name, const std::vector<cv::Mat>& frames, Score* sc,
+                      RunFigures* run);
   Status RunPipeline(const std::string& name, Method m, bool video, VideoScorer* vs, Score* sc,
                      RunFigures* run,
                      std::vector<std::pair<std::string, std::string>>* composite_rows);
@@ -181,7 +195,7 @@ Status PresetRun::MakeInputVideo() {
   input_dir_ = tmpl;
   const std::string path = input_dir_ + "/input.mkv";
   LosslessVideoWriter w;
-  Status s = w.Open(path, o_.width, o_.height, so_.fps);
+  Status s = w.Open(path, sim_->intrinsics().width, sim_->intrinsics().height, so_.fps);
   cv::Mat frame;
   sim::SimTruth truth;
   for (int i = 0; s.ok() && i < sim_->num_frames(); ++i) {
@@ -195,26 +209,74 @@ Status PresetRun::MakeInputVideo() {
   return Status::Ok();
 }
 
-Status PresetRun::RunPeer(const std::string& name, VideoScorer* vs, RunFigures* run) {
+Status PresetRun::RunPeer(const std::string& name, VideoScorer* vs, Score* sc,
+                          RunFigures* run) {
   if (input_video_.empty()) {
     const Status s = MakeInputVideo();
     if (!s.ok()) return s;
   }
-  const FfmpegMethod fm = name == "ffmpeg-vidstab" ? FfmpegMethod::kVidstab
-                                                   : FfmpegMethod::kDeshake;
+  const FfmpegMethod fm = name.compare(0, 14, "ffmpeg-vidstab") == 0 ? FfmpegMethod::kVidstab
+                                                                    : FfmpegMethod::kDeshake;
   // Time ffmpeg alone: collect its frames first, score afterwards.
   std::vector<cv::Mat> frames;
   double seconds = 0.0;
   Status s = RunFfmpegStabilizer(
-      fm, input_video_, o_.width, o_.height, input_dir_,
+      fm, input_video_, sim_->intrinsics().width, sim_->intrinsics().height, input_dir_,
       [&frames](const cv::Mat& f) {
         frames.push_back(f.clone());
         return Status::Ok();
       },
-      &seconds);
-  for (size_t i = 0; s.ok() && i < frames.size(); ++i) s = vs->Add(frames[i]);
+      &seconds, o_.peer);
   if (s.ok()) run->peer_ms = 1000.0 * seconds / std::max<size_t>(1, frames.size());
+  if (s.ok() && vs == nullptr) return ScoreAligned(name, frames, sc, run);
+  for (size_t i = 0; s.ok() && i < frames.size(); ++i) s = vs->Add(frames[i]);
   return s;
+}
+
+// The peer's frames scored by the exact scorecard: each aligned to the
+// input frame it was made from, the truth mapped through that alignment.
+Status PresetRun::ScoreAligned(const std::string& name, const std::vector<cv::Mat>& frames,
+                               Score* sc, RunFigures* run) {
+  if (static_cast<int>(frames.size()) != sim_->num_frames()) {
+    return Status::Error(name + ": " + std::to_string(frames.size()) + " frames out of " +
+                         std::to_string(sim_->num_frames()));
+  }
+  PipelineOptions po;
+  Status s = PipelineOptionsFor(o_, *sim_, Method::kNone, &po);
+  std::unique_ptr<Scorecard> card;
+  if (s.ok()) s = MakeScorecard(*sim_, po, &card, o_.window_s);
+  if (!s.ok()) return s;
+  PeerAlignment a;
+  cv::Mat input, in_grey, out_grey;
+  sim::SimTruth truth;
+  run->alignment_rms_px = 0.0;
+  run->alignment_min_inliers = std::numeric_limits<int>::max();
+  for (int i = 0; i < sim_->num_frames(); ++i) {
+    s = sim_->Render(i, &input, &truth);
+    if (!s.ok()) return s;
+    auto grey = [](const cv::Mat& bgr, cv::Mat* g) {
+      if (bgr.channels() == 1) {
+        *g = bgr;
+      } else {
+        cv::cvtColor(bgr, *g, cv::COLOR_BGR2GRAY);
+      }
+    };
+    grey(input, &in_grey);
+    grey(frames[i], &out_grey);
+    // Seeded by the frame before (ORB's on the first frame, or if that fails).
+    s = AlignPeerFrame(in_grey, out_grey, a.H, i > 0, PeerAlignmentOptions(), &a);
+    if (!s.ok()) return Status::Error(name + ", frame " + std::to_string(i) + ": " + s.message());
+    run->alignment_rms_px = std::max(run->alignment_rms_px, a.rms_px);
+    run->alignment_min_inliers = std::min(run->alignment_min_inliers, a.inliers);
+    FrameWarp w;
+    w.kind = FrameWarp::Kind::kHomography;
+    w.H = a.H;
+    card->Add(i, w);
+  }
+  *sc = card->Compute();
+  run->aligned = true;
+  return WriteTrajectory(OutPath("traj_", name.substr(0, name.size() - 8) + "-aligned"),
+                         card->samples(), {});
 }
 
 Status PresetRun::WriteExtras(const std::string& name, Method m, const PipelineOptions& po,
@@ -288,7 +350,7 @@ Status PresetRun::Run(const std::string& name, Score* sc, RunFigures* run, bool*
   const bool peer = IsPeer(name);
   run->duration_s = so_.duration_s;
   std::unique_ptr<VideoScorer> vs;
-  if (video || peer) {
+  if (video || (peer && !IsAligned(name))) {
     VideoScorerOptions vo;
     vo.fps = so_.fps;
     const Status s = VideoScorer::Create(sim_->intrinsics(), vo, &vs);
@@ -297,7 +359,7 @@ Status PresetRun::Run(const std::string& name, Score* sc, RunFigures* run, bool*
       return s;
     }
   }
-  const Status s = peer ? RunPeer(name, vs.get(), run)
+  const Status s = peer ? RunPeer(name, vs.get(), sc, run)
                         : RunPipeline(name, MethodFromName(video ? name.substr(0, name.size() - 6)
                                                                  : name),
                                       video, vs.get(), sc, run, composite_rows);

@@ -180,10 +180,11 @@ Status WriteTrajectory(const std::string& path, const std::vector<Scorecard::Sam
   std::ofstream csv(path);
   csv << "t,head_in_x,head_in_y,head_out_x,head_out_y,head_valid,bg_out_x,bg_out_y,"
          "virt_rx,virt_ry,virt_rz,real_rx,real_ry,real_rz,tx,ty,"
-         "crop_ratio,crop_need,w_fit,protrusion_search_s,previous_warp\n";
+         "crop_ratio,crop_need,w_fit,protrusion_search_s,previous_warp,C_x,C_y,H_x,H_y\n";
   // The stabilizer's own record (nan for "none"): the w_f in effect, how
   // far the protrusion search moved towards the real pose (-1: it did not
-  // run) and whether the previous warp was reused.
+  // run), whether the previous warp was reused, and the landmark centre C
+  // and head target H it was handed [normalized; nan without a target].
   for (size_t i = 0; i < samples.size(); ++i) {
     const auto& p = samples[i];
     csv << p.t << "," << p.head_in.x() << "," << p.head_in.y() << "," << p.head_out.x() << ","
@@ -196,9 +197,14 @@ Status WriteTrajectory(const std::string& path, const std::vector<Scorecard::Sam
       const StabilizerFrame& f = frames[i];
       csv << "," << f.weights.fit << ","
           << (f.flags.protrusion_search ? f.flags.protrusion_search_s : -1.0) << ","
-          << f.flags.previous_warp << "\n";
+          << f.flags.previous_warp;
+      if (f.has_target) {
+        csv << "," << f.C.x() << "," << f.C.y() << "," << f.H.x() << "," << f.H.y() << "\n";
+      } else {
+        csv << ",nan,nan,nan,nan\n";
+      }
     } else {
-      csv << ",nan,nan,nan\n";  // no stabilizer (input)
+      csv << ",nan,nan,nan,nan,nan,nan,nan\n";  // no stabilizer (input)
     }
   }
   return csv ? Status::Ok() : Status::Error("cannot write " + path);
@@ -217,6 +223,12 @@ std::string Fmt(const char* f, double v) {
   char b[64];
   std::snprintf(b, sizeof(b), f, v);
   return std::string(b);
+}
+
+// exact: the method's own warp; aligned: a peer's output aligned to the
+// input frame by frame; approximate: measured on the output video.
+const char* ScoringName(const RunFigures& run) {
+  return run.approximate ? "approximate" : run.aligned ? "aligned" : "exact";
 }
 
 }  // namespace
@@ -247,8 +259,7 @@ std::string TableRow(const std::string& preset, const std::string& method, const
     << " | " << Fmt("%.2f", sc.blend_max_step_px) << ", " << Fmt("%.2f", sc.blend_max_accel_px)
     << " | " << Fmt("%.2f", sc.head_max_step_px) << ", " << Fmt("%.2f", sc.head_max_accel_px)
     << " | " << Fmt("%.2f", sc.head_target_max_step_px) << ", "
-    << Fmt("%.2f", sc.head_target_max_accel_px) << " | "
-    << (run.approximate ? "approximate" : "exact") << " |";
+    << Fmt("%.2f", sc.head_target_max_accel_px) << " | " << ScoringName(run) << " |";
   return o.str();
 }
 
@@ -315,10 +326,12 @@ std::string JsonResult(const std::string& preset, const std::string& method, con
                        const RunFigures& run) {
   std::ostringstream o;
   o << "    {\"preset\": \"" << preset << "\", \"duration_s\": " << run.duration_s
-    << ", \"method\": \"" << method << "\", \"scoring\": \""
-    << (run.approximate ? "approximate" : "exact") << "\", \"frames\": " << sc.frames
+    << ", \"method\": \"" << method << "\", \"scoring\": \"" << ScoringName(run)
+    << "\", \"frames\": " << sc.frames
     << JsonScoreFields(sc) << ", \"face_fraction\": " << JsonNumber(run.face_fraction)
     << JsonDetailFields(sc) << ", \"peer_wall_ms_per_frame\": " << JsonNumber(run.peer_ms)
+    << ", \"alignment_rms_px\": " << JsonNumber(run.alignment_rms_px)
+    << ", \"alignment_min_inliers\": " << run.alignment_min_inliers
     << ", \"stage_ms\": {";
   for (size_t k = 0; k < sc.stage_ms.size(); ++k) {
     o << (k ? ", " : "") << "\"" << sc.stage_ms[k].first << "\": ["

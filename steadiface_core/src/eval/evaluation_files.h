@@ -59,6 +59,12 @@ struct RunFigures {
   double solver_ms = NAN, face_ms = NAN, peer_ms = NAN;  ///< medians; peer: ffmpeg's per frame
   double face_fraction = NAN;  ///< frames whose face entered E_f
   bool approximate = false;    ///< scored from the output video
+  /// A peer scored through per-frame alignments of its output to the input
+  /// (AlignPeerFrame): the worst frame's RMS fit residual [px] and its
+  /// fewest inliers.
+  bool aligned = false;
+  double alignment_rms_px = NAN;
+  int alignment_min_inliers = -1;
   double duration_s = 0.0;
   std::string options_conflict;  ///< OptionsConflict of the run's options
 };

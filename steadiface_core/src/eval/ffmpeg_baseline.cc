@@ -146,7 +146,7 @@ Status ReadVideo(const std::string& path, const std::function<Status(const cv::M
 Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int width,
                            int height, const std::string& work_dir,
                            const std::function<Status(const cv::Mat&)>& sink,
-                           double* seconds) {
+                           double* seconds, const FfmpegPeerOptions& peer) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::string base = "ffmpeg -hide_banner -loglevel error -nostdin -y -i " + Quote(input);
   std::string filter;
@@ -161,6 +161,12 @@ Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int wi
       return Status::Error("ffmpeg vidstabdetect failed: " + log);
     }
     filter = "format=yuv420p,vidstabtransform=input=" + Quote(trf);
+    char extra[96] = "";
+    if (std::isfinite(peer.vidstab_zoom_percent)) {
+      std::snprintf(extra, sizeof(extra), ":optzoom=0:zoom=%.4f", peer.vidstab_zoom_percent);
+      filter += extra;
+    }
+    if (peer.vidstab_smoothing >= 0) filter += ":smoothing=" + std::to_string(peer.vidstab_smoothing);
   } else {
     filter = "format=yuv420p,deshake";
   }

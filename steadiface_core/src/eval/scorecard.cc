@@ -226,7 +226,11 @@ void Scorecard::Add(int index, const FrameWarp& w) {
     frame_output_ = output_.WithCropRatio(r);
     frame_protrusion_ = ProtrusionGeometry(model_, frame_output_, 16);
   }
-  kept_width_.push_back(w.kind == FrameWarp::Kind::kIdentity ? 1.0 : 1.0 - 2.0 * r);
+  // A homography's view: the input's width over its scale (a peer's zoom).
+  const double scale = std::sqrt(std::abs(w.H.topLeftCorner<2, 2>().determinant()));
+  kept_width_.push_back(w.kind == FrameWarp::Kind::kIdentity     ? 1.0
+                        : w.kind == FrameWarp::Kind::kHomography ? std::min(1.0, 1.0 / scale)
+                                                                 : 1.0 - 2.0 * r);
   Sample s;
   s.t = ToSeconds(truth.stamp);
   s.crop_ratio = r;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "steadiface_core/composite/compositor.h"
+#include "steadiface_core/eval/ffmpeg_baseline.h"
 #include "steadiface_core/layered/layer_blend.h"
 #include "steadiface_core/pipeline/pipeline.h"
 #include "steadiface_core/sim/motion.h"
@@ -97,6 +98,11 @@ struct EvaluationOptions {
   Eigen::Vector2d window_s = Eigen::Vector2d::Constant(NAN);
   /// head.w_stay [-] and head.d_ref [fraction of the width].
   double head_w_stay = NAN, head_d_ref = NAN;
+  /// stabilizer.intentional_window_s: E_r C0 follows the camera's mean
+  /// rotation rate over this trailing window [s]; 0 = the paper's term.
+  double intentional_window_s = NAN;
+  /// The ffmpeg peers' settings (their defaults unless set).
+  FfmpegPeerOptions peer;
   /// terms.protrusion_alpha_face: E_p's tolerance while a face is fitted
   /// [fraction of the width].
   double protrusion_alpha_face = NAN;

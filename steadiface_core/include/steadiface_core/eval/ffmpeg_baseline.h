@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <string>
 
@@ -45,7 +46,20 @@ class LosslessVideoWriter {
 Status ReadVideo(const std::string& path, const std::function<Status(const cv::Mat&)>& sink,
                  int* width, int* height);
 
-/// Runs `method` with its default settings on `input` (any video ffmpeg
+/// Settings of a peer other than its defaults (for "best of its settings"
+/// comparisons and for comparing at one field of view).
+struct FfmpegPeerOptions {
+  /// vidstabtransform's zoom [percent], with optzoom off: the output shows
+  /// 1 - zoom/100 of the input's width (scaled by 1 / (1 - zoom/100) about
+  /// its centre; measured, PeerAlignmentTest), so 30 is the default 0.70
+  /// crop's view; NaN: its default (optzoom=1, the smallest static zoom
+  /// that hides the borders of all but the strongest motion).
+  double vidstab_zoom_percent = NAN;
+  /// vidstabtransform's smoothing [frames each side]; < 0: its default (15).
+  int vidstab_smoothing = -1;
+};
+
+/// Runs `method` with its default settings (or `peer`'s) on `input` (any video ffmpeg
 /// reads; converted to yuv420p first, the format phone videos come in and
 /// the one libvidstab handles — it aborts on packed or planar RGB),
 /// decoding the stabilized frames to bgr8 and handing each to `sink`.
@@ -56,7 +70,7 @@ Status ReadVideo(const std::string& path, const std::function<Status(const cv::M
 Status RunFfmpegStabilizer(FfmpegMethod method, const std::string& input, int width,
                            int height, const std::string& work_dir,
                            const std::function<Status(const cv::Mat&)>& sink,
-                           double* seconds);
+                           double* seconds, const FfmpegPeerOptions& peer = FfmpegPeerOptions());
 
 }  // namespace eval
 }  // namespace steadiface

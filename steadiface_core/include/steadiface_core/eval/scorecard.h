@@ -243,7 +243,7 @@ class Scorecard {
   // The frame being added: the output geometry at its crop, its boundary.
   OutputGeometry frame_output_;
   ProtrusionGeometry frame_protrusion_;
-  std::vector<double> kept_width_;  // per frame, 1 - 2 r
+  std::vector<double> kept_width_;  // per frame, 1 - 2 r (a homography: 1 / its scale)
   std::vector<double> output_roll_, input_roll_;  // per frame [rad]
   std::vector<Eigen::Vector3d> background_dirs_;
   std::vector<Eigen::Vector3d> visible_dirs_;
