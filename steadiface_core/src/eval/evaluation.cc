@@ -233,6 +233,15 @@ Status PresetRun::RunPeer(const std::string& name, VideoScorer* vs, Score* sc,
   return s;
 }
 
+// `bgr` as 8-bit grey (a grey picture as it is).
+void Grey(const cv::Mat& bgr, cv::Mat* grey) {
+  if (bgr.channels() == 1) {
+    *grey = bgr;
+  } else {
+    cv::cvtColor(bgr, *grey, cv::COLOR_BGR2GRAY);
+  }
+}
+
 // The peer's frames scored by the exact scorecard: each aligned to the
 // input frame it was made from, the truth mapped through that alignment.
 Status PresetRun::ScoreAligned(const std::string& name, const std::vector<cv::Mat>& frames,
@@ -254,15 +263,8 @@ Status PresetRun::ScoreAligned(const std::string& name, const std::vector<cv::Ma
   for (int i = 0; i < sim_->num_frames(); ++i) {
     s = sim_->Render(i, &input, &truth);
     if (!s.ok()) return s;
-    auto grey = [](const cv::Mat& bgr, cv::Mat* g) {
-      if (bgr.channels() == 1) {
-        *g = bgr;
-      } else {
-        cv::cvtColor(bgr, *g, cv::COLOR_BGR2GRAY);
-      }
-    };
-    grey(input, &in_grey);
-    grey(frames[i], &out_grey);
+    Grey(input, &in_grey);
+    Grey(frames[i], &out_grey);
     // Seeded by the frame before (ORB's on the first frame, or if that fails).
     s = AlignPeerFrame(in_grey, out_grey, a.H, i > 0, PeerAlignmentOptions(), &a);
     if (!s.ok()) return Status::Error(name + ", frame " + std::to_string(i) + ": " + s.message());
