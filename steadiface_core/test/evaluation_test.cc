@@ -92,6 +92,11 @@ TEST(EvaluationTest, UnknownMethodsAndPresetsAreRefused) {
   EXPECT_EQ(eval::RunEvaluation(o, out, err), 2);
   EXPECT_NE(err.str().find("unknown method sideways"), std::string::npos);
   o.methods = {"none"};
+  o.peer.vidstab_zoom_percent = 100.0;  // would show nothing
+  std::ostringstream out1, err1;
+  EXPECT_EQ(eval::RunEvaluation(o, out1, err1), 2);
+  EXPECT_NE(err1.str().find("--vidstab-zoom must be in"), std::string::npos) << err1.str();
+  o.peer.vidstab_zoom_percent = NAN;
   o.presets = {"no_such_preset"};
   std::ostringstream out2, err2;
   EXPECT_EQ(eval::RunEvaluation(o, out2, err2), 1);  // ran, and that preset failed

@@ -428,6 +428,17 @@ int RunEvaluation(const EvaluationOptions& o, std::ostream& out, std::ostream& e
   std::vector<std::string> methods;
   const int bad = ResolveMethods(o.methods, have_ffmpeg, err, &methods);
   if (bad != 0) return bad;
+  // vidstabtransform's own ranges (zoom -100..100, where 100 would show
+  // nothing; smoothing 0..1000).
+  const double zoom = o.peer.vidstab_zoom_percent;
+  if (!std::isnan(zoom) && !(zoom > -100.0 && zoom < 100.0)) {
+    err << "--vidstab-zoom must be in (-100, 100) percent\n";
+    return 2;
+  }
+  if (o.peer.vidstab_smoothing > 1000) {
+    err << "--vidstab-smoothing must be at most 1000 frames\n";
+    return 2;
+  }
   mkdir(o.out_dir.c_str(), 0755);
   std::ofstream json(o.out_dir + "/report.json");
   json << "{\n  \"duration_s\": " << JsonNumber(o.duration_s) << ",\n  \"size\": [" << o.width
