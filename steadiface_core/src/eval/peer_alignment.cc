@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -46,15 +47,16 @@ Status OrbGuess(const cv::Mat& in, const cv::Mat& out, Eigen::Matrix3d* H) {
   return Status::Ok();
 }
 
-// Input corners tracked into the output resampled through `G` (back), and
-// back again; the survivors' input points and their output points.
+// The input's `corners` tracked into the output resampled through `G`
+// (back), and back again: the input and output points of those that return
+// within `fb_px`.
 void SeededTracks(const cv::Mat& in, const cv::Mat& back,
+                  const std::vector<cv::Point2f>& corners,
                   const Eigen::Matrix3d& G, const PeerAlignmentOptions& o,
-                  std::vector<cv::Point2f>* pi, std::vector<cv::Point2f>* po) {
-  std::vector<cv::Point2f> corners, fwd, bwd;
-  cv::goodFeaturesToTrack(in, corners, o.max_corners, o.corner_quality,
-                          o.corner_spacing_px);
+                  double fb_px, std::vector<cv::Point2f>* pi,
+                  std::vector<cv::Point2f>* po) {
   if (corners.empty()) return;
+  std::vector<cv::Point2f> fwd, bwd;
   std::vector<uchar> st1, st2;
   std::vector<float> err;
   const cv::Size win(o.lk_window_px, o.lk_window_px);
@@ -67,7 +69,7 @@ void SeededTracks(const cv::Mat& in, const cv::Mat& back,
   for (size_t k = 0; k < corners.size(); ++k) {
     if (!st1[k] || !st2[k]) continue;
     const cv::Point2f d = bwd[k] - corners[k];
-    if (std::hypot(d.x, d.y) > o.forward_backward_px) continue;
+    if (std::hypot(d.x, d.y) > fb_px) continue;
     const Eigen::Vector3d q = G * Eigen::Vector3d(fwd[k].x, fwd[k].y, 1.0);
     if (!(std::abs(q.z()) > 1e-9)) continue;
     pi->push_back(corners[k]);
@@ -78,20 +80,17 @@ void SeededTracks(const cv::Mat& in, const cv::Mat& back,
 // One round: the output resampled through G (back(p) = out(G p)), the
 // input's corners tracked into it and back, a similarity fitted to those
 // within `fb_px` with RANSAC at `ransac_px`.
-Status Refine(const cv::Mat& in, const cv::Mat& out, const Eigen::Matrix3d& G,
+Status Refine(const cv::Mat& in, const cv::Mat& out,
+              const std::vector<cv::Point2f>& corners, const Eigen::Matrix3d& G,
               const PeerAlignmentOptions& o, double fb_px, double ransac_px,
               PeerAlignment* a) {
-  cv::Mat Gcv(3, 3, CV_64F), back;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) Gcv.at<double>(r, c) = G(r, c);
-  }
+  cv::Mat Gcv, back;
+  cv::eigen2cv(G, Gcv);
   cv::warpPerspective(out, back, Gcv, in.size(),
                       cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
                       cv::BORDER_CONSTANT, 0);
-  PeerAlignmentOptions strict = o;
-  strict.forward_backward_px = fb_px;
   std::vector<cv::Point2f> pi, po;
-  SeededTracks(in, back, G, strict, &pi, &po);
+  SeededTracks(in, back, corners, G, o, fb_px, &pi, &po);
   if (static_cast<int>(pi.size()) < o.min_inliers) {
     return Status::Error(std::to_string(pi.size()) + " tracks survive");
   }
@@ -117,13 +116,16 @@ Status Refine(const cv::Mat& in, const cv::Mat& out, const Eigen::Matrix3d& G,
 
 // Two rounds from G: a lenient one that brings G close, a strict one that
 // fits what is left.
-Status Align(const cv::Mat& in, const cv::Mat& out, const Eigen::Matrix3d& G,
+Status Align(const cv::Mat& in, const cv::Mat& out,
+             const std::vector<cv::Point2f>& corners, const Eigen::Matrix3d& G,
              const PeerAlignmentOptions& o, PeerAlignment* a) {
   PeerAlignment rough;
-  Status s = Refine(in, out, G, o, 4.0 * o.forward_backward_px,
+  Status s = Refine(in, out, corners, G, o, 4.0 * o.forward_backward_px,
                     4.0 * o.ransac_px, &rough);
-  if (s.ok())
-    s = Refine(in, out, rough.H, o, o.forward_backward_px, o.ransac_px, a);
+  if (s.ok()) {
+    s = Refine(in, out, corners, rough.H, o, o.forward_backward_px, o.ransac_px,
+               a);
+  }
   return s;
 }
 
@@ -137,15 +139,20 @@ Status AlignPeerFrame(const cv::Mat& input_grey, const cv::Mat& output_grey,
       input_grey.size() != output_grey.size()) {
     return Status::Error("AlignPeerFrame: two 8-bit grey frames of one size");
   }
+  // The input's corners, found once for every round.
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(input_grey, corners, options.max_corners,
+                          options.corner_quality, options.corner_spacing_px);
   PeerAlignment a;
   Status s = Status::Error("no guess");
-  if (has_guess && guess.allFinite())
-    s = Align(input_grey, output_grey, guess, options, &a);
+  if (has_guess && guess.allFinite()) {
+    s = Align(input_grey, output_grey, corners, guess, options, &a);
+  }
   if (!s.ok()) {
     // No guess, or it was too far off: ORB's.
     Eigen::Matrix3d G;
     s = OrbGuess(input_grey, output_grey, &G);
-    if (s.ok()) s = Align(input_grey, output_grey, G, options, &a);
+    if (s.ok()) s = Align(input_grey, output_grey, corners, G, options, &a);
   }
   if (!s.ok()) return Status::Error("AlignPeerFrame: " + s.message());
   *out = a;
