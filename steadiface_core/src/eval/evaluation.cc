@@ -37,14 +37,26 @@ bool KnownMethod(const std::string& name) {
 
 bool IsPeer(const std::string& name) { return name.compare(0, 7, "ffmpeg-") == 0; }
 
-// A peer scored through its frames aligned to the input (AlignPeerFrame).
-bool IsAligned(const std::string& name) {
-  return name.size() > 8 && name.compare(name.size() - 8, 8, "/aligned") == 0;
+// `name` is a method with `suffix` after its base name.
+bool HasSuffix(const std::string& name, const std::string& suffix) {
+  return name.size() > suffix.size() &&
+         name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-bool IsVideo(const std::string& name) {
-  return name.size() > 6 && name.compare(name.size() - 6, 6, "/video") == 0;
+// A peer scored through its frames aligned to the input (AlignPeerFrame).
+bool IsAligned(const std::string& name) { return HasSuffix(name, "/aligned"); }
+
+bool IsVideo(const std::string& name) { return HasSuffix(name, "/video"); }
+
+// `bgr` as 8-bit grey (a grey picture as it is).
+void Grey(const cv::Mat& bgr, cv::Mat* grey) {
+  if (bgr.channels() == 1) {
+    *grey = bgr;
+  } else {
+    cv::cvtColor(bgr, *grey, cv::COLOR_BGR2GRAY);
+  }
 }
+
 
 // The methods to run (the default set when none is asked for), each known
 // and, for ffmpeg's, with ffmpeg there; 0 or the exit status 2.
@@ -187,6 +199,9 @@ class PresetRun {
   sim::SimulatorOptions so_;
   std::unique_ptr<sim::Simulator> sim_;
   std::string input_dir_, input_video_;
+  // The input's frames in grey, kept as they are rendered for the video,
+  // for the aligned peers.
+  std::vector<cv::Mat> input_grey_;
 };
 
 Status PresetRun::MakeInputVideo() {
@@ -201,6 +216,10 @@ Status PresetRun::MakeInputVideo() {
   for (int i = 0; s.ok() && i < sim_->num_frames(); ++i) {
     s = sim_->Render(i, &frame, &truth);
     if (s.ok()) s = w.Write(frame);
+    if (s.ok()) {
+      input_grey_.emplace_back();
+      Grey(frame, &input_grey_.back());
+    }
   }
   const Status c = w.Close();
   if (s.ok()) s = c;
@@ -228,27 +247,18 @@ Status PresetRun::RunPeer(const std::string& name, VideoScorer* vs, Score* sc,
       },
       &seconds, o_.peer);
   if (s.ok()) run->peer_ms = 1000.0 * seconds / std::max<size_t>(1, frames.size());
-  if (s.ok() && vs == nullptr) return ScoreAligned(name, frames, sc, run);
+  if (s.ok() && IsAligned(name)) return ScoreAligned(name, frames, sc, run);
   for (size_t i = 0; s.ok() && i < frames.size(); ++i) s = vs->Add(frames[i]);
   return s;
-}
-
-// `bgr` as 8-bit grey (a grey picture as it is).
-void Grey(const cv::Mat& bgr, cv::Mat* grey) {
-  if (bgr.channels() == 1) {
-    *grey = bgr;
-  } else {
-    cv::cvtColor(bgr, *grey, cv::COLOR_BGR2GRAY);
-  }
 }
 
 // The peer's frames scored by the exact scorecard: each aligned to the
 // input frame it was made from, the truth mapped through that alignment.
 Status PresetRun::ScoreAligned(const std::string& name, const std::vector<cv::Mat>& frames,
                                Score* sc, RunFigures* run) {
-  if (static_cast<int>(frames.size()) != sim_->num_frames()) {
+  if (frames.size() != input_grey_.size()) {
     return Status::Error(name + ": " + std::to_string(frames.size()) + " frames out of " +
-                         std::to_string(sim_->num_frames()));
+                         std::to_string(input_grey_.size()));
   }
   PipelineOptions po;
   Status s = PipelineOptionsFor(o_, *sim_, Method::kNone, &po);
@@ -256,17 +266,13 @@ Status PresetRun::ScoreAligned(const std::string& name, const std::vector<cv::Ma
   if (s.ok()) s = MakeScorecard(*sim_, po, &card, o_.window_s);
   if (!s.ok()) return s;
   PeerAlignment a;
-  cv::Mat input, in_grey, out_grey;
-  sim::SimTruth truth;
+  cv::Mat out_grey;
   run->alignment_rms_px = 0.0;
   run->alignment_min_inliers = std::numeric_limits<int>::max();
-  for (int i = 0; i < sim_->num_frames(); ++i) {
-    s = sim_->Render(i, &input, &truth);
-    if (!s.ok()) return s;
-    Grey(input, &in_grey);
+  for (int i = 0; i < static_cast<int>(frames.size()); ++i) {
     Grey(frames[i], &out_grey);
     // Seeded by the frame before (ORB's on the first frame, or if that fails).
-    s = AlignPeerFrame(in_grey, out_grey, a.H, i > 0, PeerAlignmentOptions(), &a);
+    s = AlignPeerFrame(input_grey_[i], out_grey, a.H, i > 0, PeerAlignmentOptions(), &a);
     if (!s.ok()) return Status::Error(name + ", frame " + std::to_string(i) + ": " + s.message());
     run->alignment_rms_px = std::max(run->alignment_rms_px, a.rms_px);
     run->alignment_min_inliers = std::min(run->alignment_min_inliers, a.inliers);
